@@ -1,0 +1,15 @@
+//! Triangle meshes for deformbench: the [`TriMesh`] type and its validation, adjacency
+//! ([`Topology`]), per-element geometry, file I/O (OFF, OBJ, glTF/GLB, the survey `.sel`/`.def`
+//! edits) and procedural look-alikes of the four Botsch–Sorkine test shapes.
+
+pub mod edit;
+pub mod error;
+pub mod geometry;
+pub mod mesh;
+pub mod topology;
+pub mod vector;
+
+pub use edit::{AffineTransform, VertexStatus};
+pub use error::{MeshError, Result};
+pub use mesh::TriMesh;
+pub use topology::{Topology, NO_FACE};
