@@ -44,12 +44,7 @@ pub struct AffineTransform {
 impl AffineTransform {
     /// The identity transform.
     pub const IDENTITY: AffineTransform = AffineTransform {
-        rows: [
-            [1.0, 0.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0, 0.0],
-            [0.0, 0.0, 1.0, 0.0],
-            [0.0, 0.0, 0.0, 1.0],
-        ],
+        rows: [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]],
     };
 
     /// Build from 4 rows; every entry must be finite and the last row `0 0 0 1` (to 1e-9).
@@ -85,8 +80,7 @@ impl AffineTransform {
         let mut rows = [[0.0; 4]; 4];
         for i in 0..3 {
             rows[i][..3].copy_from_slice(&r[i]);
-            rows[i][3] =
-                center[i] - (r[i][0] * center[0] + r[i][1] * center[1] + r[i][2] * center[2]);
+            rows[i][3] = center[i] - (r[i][0] * center[0] + r[i][1] * center[1] + r[i][2] * center[2]);
         }
         rows[3] = [0.0, 0.0, 0.0, 1.0];
         Self { rows }
@@ -120,20 +114,12 @@ impl AffineTransform {
     /// `T * (p, 1)`.
     pub fn apply(&self, p: [f64; 3]) -> [f64; 3] {
         std::array::from_fn(|i| {
-            self.rows[i][0] * p[0]
-                + self.rows[i][1] * p[1]
-                + self.rows[i][2] * p[2]
-                + self.rows[i][3]
+            self.rows[i][0] * p[0] + self.rows[i][1] * p[1] + self.rows[i][2] * p[2] + self.rows[i][3]
         })
     }
 }
 
 /// Vertex indices with the given status, ascending.
 pub fn vertices_with_status(selection: &[VertexStatus], status: VertexStatus) -> Vec<u32> {
-    selection
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| **s == status)
-        .map(|(i, _)| i as u32)
-        .collect()
+    selection.iter().enumerate().filter(|(_, s)| **s == status).map(|(i, _)| i as u32).collect()
 }

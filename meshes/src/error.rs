@@ -30,20 +30,10 @@ pub enum MeshError {
     Empty(&'static str),
     /// A coordinate is NaN or infinite.
     #[error("vertex {vertex}: coordinate {axis} is {value}, not a finite number")]
-    NonFiniteCoordinate {
-        vertex: usize,
-        axis: usize,
-        value: f64,
-    },
+    NonFiniteCoordinate { vertex: usize, axis: usize, value: f64 },
     /// A face refers to a vertex that does not exist.
-    #[error(
-        "face {face}: vertex index {index} is out of range (the mesh has {n_vertices} vertices)"
-    )]
-    IndexOutOfRange {
-        face: usize,
-        index: u64,
-        n_vertices: usize,
-    },
+    #[error("face {face}: vertex index {index} is out of range (the mesh has {n_vertices} vertices)")]
+    IndexOutOfRange { face: usize, index: u64, n_vertices: usize },
     /// A face is not a triangle.
     #[error("face {face}: has {corners} corners; only triangles are supported")]
     NotATriangle { face: usize, corners: usize },
@@ -61,11 +51,7 @@ pub enum MeshError {
     DegenerateFace { face: usize, area: f64 },
     /// A per-vertex array does not match the mesh.
     #[error("{what} has {got} entries but the mesh has {expected} vertices")]
-    LengthMismatch {
-        what: &'static str,
-        got: usize,
-        expected: usize,
-    },
+    LengthMismatch { what: &'static str, got: usize, expected: usize },
     /// A value is outside what a format allows.
     #[error("{0}")]
     Invalid(String),
@@ -76,10 +62,7 @@ impl MeshError {
     pub fn in_file(self, path: impl Into<PathBuf>) -> MeshError {
         match self {
             e @ MeshError::InFile { .. } => e,
-            e => MeshError::InFile {
-                path: path.into(),
-                source: Box::new(e),
-            },
+            e => MeshError::InFile { path: path.into(), source: Box::new(e) },
         }
     }
 }

@@ -28,10 +28,7 @@ pub fn triangle_area(positions: &[[f64; 3]], tri: &[u32; 3]) -> f64 {
 
 /// `#F` face areas.
 pub fn face_areas(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<f64> {
-    triangles
-        .iter()
-        .map(|t| triangle_area(positions, t))
-        .collect()
+    triangles.iter().map(|t| triangle_area(positions, t)).collect()
 }
 
 /// `#F` unit face normals (right-hand rule on the corner order); zero for a zero-area face.
@@ -76,11 +73,7 @@ pub fn corner_angles(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<[f64
 
 /// One angle per interior edge of `topology` (in [`Topology::interior_edges`] order): the angle in
 /// radians between the unit normals of the two adjacent faces, in `[0, pi]` (0 where the surface is flat).
-pub fn dihedral_angles(
-    positions: &[[f64; 3]],
-    triangles: &[[u32; 3]],
-    topology: &Topology,
-) -> Vec<f64> {
+pub fn dihedral_angles(positions: &[[f64; 3]], triangles: &[[u32; 3]], topology: &Topology) -> Vec<f64> {
     let normals = face_normals(positions, triangles);
     topology
         .interior_edges()

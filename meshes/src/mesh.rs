@@ -28,30 +28,17 @@ impl TriMesh {
         for (f, t) in triangles.iter().enumerate() {
             for &i in t {
                 if i as usize >= n {
-                    return Err(MeshError::IndexOutOfRange {
-                        face: f,
-                        index: i as u64,
-                        n_vertices: n,
-                    });
+                    return Err(MeshError::IndexOutOfRange { face: f, index: i as u64, n_vertices: n });
                 }
             }
             if t[0] == t[1] || t[0] == t[2] {
-                return Err(MeshError::RepeatedVertex {
-                    face: f,
-                    vertex: t[0],
-                });
+                return Err(MeshError::RepeatedVertex { face: f, vertex: t[0] });
             }
             if t[1] == t[2] {
-                return Err(MeshError::RepeatedVertex {
-                    face: f,
-                    vertex: t[1],
-                });
+                return Err(MeshError::RepeatedVertex { face: f, vertex: t[1] });
             }
         }
-        Ok(Self {
-            positions,
-            triangles,
-        })
+        Ok(Self { positions, triangles })
     }
 
     /// Number of vertices `#V`.
@@ -84,10 +71,7 @@ impl TriMesh {
             });
         }
         check_finite(&positions)?;
-        Ok(Self {
-            positions,
-            triangles: self.triangles.clone(),
-        })
+        Ok(Self { positions, triangles: self.triangles.clone() })
     }
 
     /// Diagonal length of the axis-aligned bounding box.
@@ -113,11 +97,7 @@ fn check_finite(positions: &[[f64; 3]]) -> Result<()> {
     for (v, p) in positions.iter().enumerate() {
         for (axis, &value) in p.iter().enumerate() {
             if !value.is_finite() {
-                return Err(MeshError::NonFiniteCoordinate {
-                    vertex: v,
-                    axis,
-                    value,
-                });
+                return Err(MeshError::NonFiniteCoordinate { vertex: v, axis, value });
             }
         }
     }

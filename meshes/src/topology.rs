@@ -46,19 +46,10 @@ impl Topology {
             }
             let group = &half[i..j];
             if group.len() > 2 {
-                return Err(MeshError::NonManifoldEdge {
-                    a,
-                    b,
-                    faces: group.iter().map(|h| h.2).collect(),
-                });
+                return Err(MeshError::NonManifoldEdge { a, b, faces: group.iter().map(|h| h.2).collect() });
             }
             if group.len() == 2 && group[0].4 == group[1].4 {
-                return Err(MeshError::InconsistentOrientation {
-                    a,
-                    b,
-                    f0: group[0].2,
-                    f1: group[1].2,
-                });
+                return Err(MeshError::InconsistentOrientation { a, b, f0: group[0].2, f1: group[1].2 });
             }
             let e = edges.len() as u32;
             edges.push([a, b]);
@@ -92,14 +83,7 @@ impl Topology {
         }
 
         let boundary_loops = boundary_loops(tris, &edges, &edge_faces, &face_edges);
-        Ok(Self {
-            edges,
-            edge_faces,
-            face_edges,
-            ring_offsets,
-            ring,
-            boundary_loops,
-        })
+        Ok(Self { edges, edge_faces, face_edges, ring_offsets, ring, boundary_loops })
     }
 
     /// `#E` unique edges `[a, b]` with `a < b`, sorted lexicographically.
@@ -119,11 +103,7 @@ impl Topology {
 
     /// Indices of the interior edges (two adjacent faces), ascending.
     pub fn interior_edges(&self) -> impl Iterator<Item = usize> + '_ {
-        self.edge_faces
-            .iter()
-            .enumerate()
-            .filter(|(_, f)| f[1] != NO_FACE)
-            .map(|(e, _)| e)
+        self.edge_faces.iter().enumerate().filter(|(_, f)| f[1] != NO_FACE).map(|(e, _)| e)
     }
 
     /// Sorted neighbours of vertex `v`.
@@ -155,10 +135,7 @@ fn boundary_loops(
             continue;
         }
         let f = ef[0] as usize;
-        let k = face_edges[f]
-            .iter()
-            .position(|&x| x as usize == e)
-            .expect("face lists its edge");
+        let k = face_edges[f].iter().position(|&x| x as usize == e).expect("face lists its edge");
         let a = tris[f][(k + 1) % 3];
         let b = tris[f][(k + 2) % 3];
         debug_assert!(edges[e] == [a.min(b), a.max(b)]);
@@ -179,10 +156,7 @@ fn boundary_loops(
             let b = next[cur].1;
             // First unused boundary half-edge leaving b (a vertex may touch two loops).
             let lo = next.partition_point(|h| h.0 < b);
-            match (lo..next.len())
-                .take_while(|&i| next[i].0 == b)
-                .find(|&i| !used[i])
-            {
+            match (lo..next.len()).take_while(|&i| next[i].0 == b).find(|&i| !used[i]) {
                 Some(i) => cur = i,
                 None => break,
             }
