@@ -44,17 +44,9 @@ pub fn face_normals(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<[f64;
 
 /// `#V` unit vertex normals, the area-weighted mean of the adjacent face normals.
 pub fn vertex_normals(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<[f64; 3]> {
-    let mut acc = vec![[0.0f64; 3]; positions.len()];
-    for t in triangles {
-        let [a, b, c] = t.map(|i| positions[i as usize]);
-        let n2 = cross(sub(b, a), sub(c, a)); // twice the area times the unit normal
-        for &i in t {
-            for k in 0..3 {
-                acc[i as usize][k] += n2[k];
-            }
-        }
-    }
-    acc.into_iter().map(normalize_or_zero).collect()
+    let mut out = vec![[0.0f64; 3]; positions.len()];
+    vertex_normals_into(positions, triangles, &mut out);
+    out
 }
 
 /// `#F x 3` interior angles in radians; entry `k` is the angle at corner `k`.
@@ -82,4 +74,20 @@ pub fn dihedral_angles(positions: &[[f64; 3]], triangles: &[[u32; 3]], topology:
             angle_between(normals[f0 as usize], normals[f1 as usize])
         })
         .collect()
+}
+
+/// [`vertex_normals`] into a preallocated `#V x 3` buffer (no allocation; for iteration loops).
+pub fn vertex_normals_into(positions: &[[f64; 3]], triangles: &[[u32; 3]], out: &mut [[f64; 3]]) {
+    out.iter_mut().for_each(|n| *n = [0.0; 3]);
+    for t in triangles {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        let n2 = cross(sub(b, a), sub(c, a));
+        for &i in t {
+            let o = &mut out[i as usize];
+            o[0] += n2[0];
+            o[1] += n2[1];
+            o[2] += n2[2];
+        }
+    }
+    out.iter_mut().for_each(|n| *n = normalize_or_zero(*n));
 }

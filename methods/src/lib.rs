@@ -1,1 +1,16 @@
+//! Deformation methods of deformbench: the [`DeformationMethod`] trait and its registry, the discrete
+//! operators and solvers they share, and one module per method.
 
+pub mod arap;
+pub mod error;
+pub mod handles;
+pub mod laplacian;
+pub mod method;
+pub mod operators;
+pub mod registry;
+pub mod rotation_fit;
+pub mod sparse_cholesky;
+
+pub use error::MethodError;
+pub use handles::{HandleRegion, HandleSet, HandleTargets};
+pub use method::{DeformationMethod, IterationObserver, IterationReport, NoObserver, SolveSummary};

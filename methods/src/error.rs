@@ -1,0 +1,24 @@
+//! Errors of the methods crate.
+
+use crate::sparse_cholesky::SolverError;
+
+/// Everything a deformation method can report instead of a result.
+#[derive(Debug, thiserror::Error)]
+pub enum MethodError {
+    #[error("unknown method `{name}`; known methods: {}", known.join(", "))]
+    UnknownMethod { name: String, known: Vec<&'static str> },
+    #[error("parameters of `{method}`: {message}")]
+    Parameters { method: &'static str, message: String },
+    #[error("handle set: {0}")]
+    Handles(String),
+    #[error("handle targets: {0}")]
+    Targets(String),
+    #[error("`{method}`: {phase} called before {missing}")]
+    Phase { method: &'static str, phase: &'static str, missing: &'static str },
+    #[error("mesh: {0}")]
+    Mesh(#[from] meshes::MeshError),
+    #[error("linear solver: {0}")]
+    Solver(#[from] SolverError),
+    #[error("`{method}` produced a non-finite position at vertex {vertex} in iteration {iteration}")]
+    NonFinite { method: &'static str, vertex: usize, iteration: usize },
+}

@@ -1,0 +1,56 @@
+//! The table of methods by name: the one place a new method is registered.
+
+use serde::de::DeserializeOwned;
+
+use crate::arap::Arap;
+use crate::error::MethodError;
+use crate::laplacian::LaplacianEditing;
+use crate::method::DeformationMethod;
+
+/// One registered method.
+pub struct MethodEntry {
+    /// Name used in configs, on the command line and in reports.
+    pub name: &'static str,
+    /// One line: what it is and where it comes from.
+    pub summary: &'static str,
+    /// Build the method from its parameter table (missing keys take the paper's defaults).
+    pub create: fn(&toml::Table) -> Result<Box<dyn DeformationMethod>, MethodError>,
+}
+
+/// Every method of the suite, in report order.
+pub const METHODS: &[MethodEntry] = &[
+    MethodEntry {
+        name: "laplacian",
+        summary: "unreduced iterative Laplacian editing (Au et al. 2007 sec. 3, eq 1-3), the reference the reduced models approximate",
+        create: |p| Ok(Box::new(LaplacianEditing::new(parse("laplacian", p)?)?)),
+    },
+    MethodEntry {
+        name: "arap",
+        summary: "As-Rigid-As-Possible surface modeling (Sorkine & Alexa 2007), cotangent weights, hard constraints",
+        create: |p| Ok(Box::new(Arap::new(parse("arap", p)?)?)),
+    },
+];
+
+/// Names of all registered methods.
+pub fn method_names() -> Vec<&'static str> {
+    METHODS.iter().map(|m| m.name).collect()
+}
+
+/// Look up `name`; [`MethodError::UnknownMethod`] lists the known names.
+pub fn find(name: &str) -> Result<&'static MethodEntry, MethodError> {
+    METHODS
+        .iter()
+        .find(|m| m.name == name)
+        .ok_or_else(|| MethodError::UnknownMethod { name: name.to_string(), known: method_names() })
+}
+
+/// Build method `name` with `params` (a TOML table of its parameters; unknown keys are errors).
+pub fn create(name: &str, params: &toml::Table) -> Result<Box<dyn DeformationMethod>, MethodError> {
+    (find(name)?.create)(params)
+}
+
+fn parse<P: DeserializeOwned>(method: &'static str, table: &toml::Table) -> Result<P, MethodError> {
+    toml::Value::Table(table.clone())
+        .try_into()
+        .map_err(|e: toml::de::Error| MethodError::Parameters { method, message: e.message().to_string() })
+}
