@@ -1,0 +1,406 @@
+#!/usr/bin/env python3
+"""Reference results computed with libigl (and scipy) for deformbench's cross-check tests.
+
+The Rust tests run this script (with the interpreter named by $DEFORMBENCH_PYTHON, set up by
+scripts/python-env from tests/crosscheck/requirements.txt) and compare the Rust implementations
+against its output. Every file written here is plain text, so the Rust side needs no extra crate
+to read it. Floats are written with '%.17g' (round-trips an f64 exactly).
+
+Mesh input is an OFF file read with igl.read_triangle_mesh (F as int64).
+
+Subcommands and formats
+-----------------------
+operators MESH OUT_DIR
+    OUT_DIR/cotmatrix.txt        igl.cotmatrix(V, F) as COO triplets, one `i j value` line per
+                                 nonzero (after sum_duplicates; entries exactly 0.0 dropped, so a
+                                 missing (i, j) means 0; sorted by i then j; 0-based indices).
+    OUT_DIR/mass_voronoi.txt     diagonal of igl.massmatrix(V, F, VORONOI), one value per line.
+    OUT_DIR/mass_barycentric.txt diagonal of igl.massmatrix(V, F, BARYCENTRIC), one value per line.
+
+arap MESH CONSTRAINTS ITERATIONS OUT
+    CONSTRAINTS: one line per constrained vertex, `index x y z` (target position); blank lines
+    and lines starting with '#' are ignored. Runs libigl ARAP with the SPOKES energy, dim 3,
+    no dynamics, max_iter = ITERATIONS, initial guess U = rest positions V.
+    OUT: one line per vertex, `x y z`.
+
+arap-timing MESH CONSTRAINTS ITERATIONS
+    Same set-up as `arap`; times arap_precomputation and arap_solve (max_iter=ITERATIONS; libigl
+    has no early exit, so it always runs ITERATIONS iterations), each best of 3 runs, and prints
+    one JSON line on stdout (precompute_s in seconds, ms_per_iteration = best solve / ITERATIONS):
+    {"mesh": ..., "vertices": n, "precompute_s": ..., "ms_per_iteration": ..., "iterations": ...}
+
+harmonic MESH CONSTRAINTS OUT
+    CONSTRAINTS: one line per boundary vertex, `index value`. igl.harmonic with k=1.
+    OUT: one value per vertex.
+
+eigs MESH K OUT
+    Generalized eigenproblem  (-L) x = lambda M x  with L = igl.cotmatrix, M = igl.massmatrix
+    (VORONOI), solved by scipy.sparse.linalg.eigsh in shift-invert mode (sigma slightly negative,
+    which='LM', k=K). Eigenvalues ascending, one per line, to OUT; eigenvectors (M-orthonormal,
+    columns matching the eigenvalues) to OUT + '.vectors', n lines of K values each.
+    Prints {"seconds": <eigsh wall time>} on stdout.
+
+constraints MESH SEL DEF OUT   (helper for tests; not a libigl computation)
+    Builds an ARAP CONSTRAINTS file from a Botsch-Sorkine .sel/.def pair: status 0 (fixed) ->
+    target = rest position, 2 (handle) -> target = T * (x, y, z, 1) with T the row-major 4x4
+    matrix in the .def, 1 (free) -> not constrained.
+
+Errors go to stderr with exit code 1. Nothing else is printed on stdout except the JSON lines of
+`arap-timing` and `eigs`.
+
+Threading: the libigl wheel links no OpenMP/TBB/BLAS; its igl::parallel_for uses std::thread
+(capped by IGL_NUM_THREADS), but the ARAP path is effectively single-threaded: measured CPU time /
+wall time of arap_precomputation and arap_solve is 1.00 on the 2-core machine, with
+IGL_NUM_THREADS unset, 1 or 2 alike. This script sets IGL_NUM_THREADS=1 (unless already set) before
+importing igl, so `arap-timing` is a strictly single-threaded baseline. (eigsh in `eigs` goes
+through scipy's bundled OpenBLAS, which may use several threads.)
+
+Precision caveat: libigl's ARAP local step fits rotations with polar_svd3x3 (McAdams et al.'s
+3x3 SVD, computed in single precision). A double-precision SPOKES implementation therefore agrees
+with `arap` only to about 1e-7 relative after one iteration (measured: 1e-6 absolute on bar,
+whose bounding-box diagonal is 76), with the gap growing slowly over iterations (1.7e-3 absolute
+on bar after 20 iterations of its 135-degree twist; 7e-6 on cactus). Compare with tolerances of
+that order, not 1e-12.
+"""
+
+import argparse
+import json
+import os
+import sys
+import time
+
+# Single-threaded libigl for comparable timings (must be set before igl is imported; harmless for
+# the other subcommands, whose results do not depend on the thread count).
+os.environ.setdefault("IGL_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+import scipy.sparse as sp  # noqa: E402
+import scipy.sparse.linalg as spla  # noqa: E402
+
+import igl  # noqa: E402
+
+
+class UsageError(Exception):
+    pass
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse exits with code 2 on bad usage; this CLI uses 1 for every error."""
+
+    def error(self, message):
+        self.print_usage(sys.stderr)
+        self.exit(1, f"{self.prog}: error: {message}\n")
+
+
+# ---------------------------------------------------------------------------------------------
+# I/O helpers
+
+
+def read_mesh(path):
+    if not os.path.isfile(path):
+        raise UsageError(f"mesh file not found: {path}")
+    V, F = igl.read_triangle_mesh(path)
+    V = np.ascontiguousarray(V, dtype=np.float64)
+    F = np.ascontiguousarray(F, dtype=np.int64)
+    if V.ndim != 2 or V.shape[0] == 0 or V.shape[1] != 3:
+        raise UsageError(f"could not read vertices from {path} (got shape {V.shape})")
+    if F.ndim != 2 or F.shape[0] == 0 or F.shape[1] != 3:
+        raise UsageError(f"could not read triangles from {path} (got shape {F.shape})")
+    return V, F
+
+
+def read_rows(path, ncols, what):
+    """Reads whitespace-separated rows of `ncols` numbers, skipping blanks and '#' comments."""
+    if not os.path.isfile(path):
+        raise UsageError(f"{what} file not found: {path}")
+    rows = []
+    with open(path) as fh:
+        for lineno, line in enumerate(fh, 1):
+            s = line.strip()
+            if not s or s.startswith("#"):
+                continue
+            parts = s.split()
+            if len(parts) != ncols:
+                raise UsageError(f"{path}:{lineno}: expected {ncols} fields, got {len(parts)}")
+            rows.append(parts)
+    if not rows:
+        raise UsageError(f"{path}: no {what} rows")
+    return rows
+
+
+def read_vector_constraints(path, n):
+    """`index x y z` lines -> (b int64 array, bc float64 (#b, 3) array)."""
+    rows = read_rows(path, 4, "constraints")
+    b = np.array([int(r[0]) for r in rows], dtype=np.int64)
+    bc = np.array([[float(x) for x in r[1:]] for r in rows], dtype=np.float64)
+    check_indices(b, n, path)
+    return b, bc
+
+
+def read_scalar_constraints(path, n):
+    """`index value` lines -> (b int64 array, bc float64 (#b, 1) array)."""
+    rows = read_rows(path, 2, "constraints")
+    b = np.array([int(r[0]) for r in rows], dtype=np.int64)
+    bc = np.array([[float(r[1])] for r in rows], dtype=np.float64)
+    check_indices(b, n, path)
+    return b, bc
+
+
+def check_indices(b, n, path):
+    if b.min() < 0 or b.max() >= n:
+        raise UsageError(f"{path}: vertex index out of range [0, {n})")
+    if len(np.unique(b)) != len(b):
+        raise UsageError(f"{path}: duplicate vertex indices")
+
+
+def write_matrix(path, A):
+    A = np.asarray(A, dtype=np.float64)
+    if A.ndim == 1:
+        A = A[:, None]
+    np.savetxt(path, A, fmt="%.17g", delimiter=" ")
+
+
+def ensure_dir(path):
+    os.makedirs(path, exist_ok=True)
+
+
+def positive_int(s):
+    try:
+        v = int(s)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {s!r}")
+    if v <= 0:
+        raise argparse.ArgumentTypeError(f"must be positive: {s!r}")
+    return v
+
+
+# ---------------------------------------------------------------------------------------------
+# operators
+
+
+def mass_diagonal(V, F, mtype):
+    M = igl.massmatrix(V, F, mtype).tocsr()
+    offdiag = M - sp.diags(M.diagonal())
+    if offdiag.count_nonzero() != 0:
+        raise RuntimeError("massmatrix is not diagonal")
+    return M.diagonal()
+
+
+def cmd_operators(args):
+    V, F = read_mesh(args.mesh)
+    ensure_dir(args.out_dir)
+
+    L = igl.cotmatrix(V, F).tocoo()
+    L.sum_duplicates()  # also sorts by (row, col)
+    # Entries that are exactly 0.0 (right angles on grid-like meshes give cot = 0 exactly; bar,
+    # cylinder and plane have thousands) are dropped: only true nonzeros are written, so readers
+    # must treat a missing (i, j) as 0.
+    keep = L.data != 0.0
+    L = sp.coo_matrix((L.data[keep], (L.row[keep], L.col[keep])), shape=L.shape)
+    with open(os.path.join(args.out_dir, "cotmatrix.txt"), "w") as fh:
+        for i, j, v in zip(L.row.tolist(), L.col.tolist(), L.data.tolist()):
+            fh.write("%d %d %.17g\n" % (i, j, v))
+
+    write_matrix(os.path.join(args.out_dir, "mass_voronoi.txt"),
+                 mass_diagonal(V, F, igl.MASSMATRIX_TYPE_VORONOI))
+    write_matrix(os.path.join(args.out_dir, "mass_barycentric.txt"),
+                 mass_diagonal(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC))
+
+
+# ---------------------------------------------------------------------------------------------
+# ARAP
+
+
+def arap_setup(V, F, b, iterations):
+    """Precomputes libigl ARAP (SPOKES energy, dim 3, no dynamics)."""
+    data = igl.ARAPData()
+    # Default energy is ARAP_ENERGY_TYPE_DEFAULT, which libigl resolves to SPOKES_AND_RIMS for
+    # triangle meshes in 3D: SPOKES must be set explicitly. Checked when this was written: with
+    # SPOKES the result differs from DEFAULT/SPOKES_AND_RIMS (0.9 max on bar) and from ELEMENTS,
+    # and matches an independent numpy SPOKES implementation up to libigl's single-precision
+    # rotation fit (see the module docstring).
+    data.energy = igl.ARAP_ENERGY_TYPE_SPOKES
+    data.with_dynamics = False
+    data.max_iter = iterations
+    if data.energy != igl.ARAP_ENERGY_TYPE_SPOKES or data.max_iter != iterations:
+        raise RuntimeError("ARAPData fields did not take the values set")
+    # The binding wants b as int32 (see igl.arap_precomputation.__doc__).
+    igl.arap_precomputation(V, F, 3, b.astype(np.int32), data)
+    return data
+
+
+def arap_solve(data, bc, V):
+    # arap_solve uses U as the initial guess (after writing bc into the constrained rows) and
+    # returns the solution as a new array.
+    return igl.arap_solve(bc, data, V.copy())
+
+
+def cmd_arap(args):
+    V, F = read_mesh(args.mesh)
+    b, bc = read_vector_constraints(args.constraints, V.shape[0])
+    data = arap_setup(V, F, b, args.iterations)
+    U = arap_solve(data, bc, V)
+    if not np.all(np.isfinite(U)):
+        raise RuntimeError("ARAP produced non-finite positions")
+    write_matrix(args.out, U)
+
+
+def cmd_arap_timing(args):
+    V, F = read_mesh(args.mesh)
+    b, bc = read_vector_constraints(args.constraints, V.shape[0])
+    repeats = 3
+
+    pre = []
+    data = None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        data = arap_setup(V, F, b, args.iterations)
+        pre.append(time.perf_counter() - t0)
+
+    solve = []
+    for _ in range(repeats):
+        U0 = V.copy()
+        t0 = time.perf_counter()
+        U = igl.arap_solve(bc, data, U0)
+        solve.append(time.perf_counter() - t0)
+    if not np.all(np.isfinite(U)):
+        raise RuntimeError("ARAP produced non-finite positions")
+
+    print(json.dumps({
+        "mesh": os.path.basename(args.mesh),
+        "vertices": int(V.shape[0]),
+        "precompute_s": min(pre),
+        "ms_per_iteration": 1000.0 * min(solve) / args.iterations,
+        "iterations": args.iterations,
+    }))
+
+
+# ---------------------------------------------------------------------------------------------
+# harmonic
+
+
+def cmd_harmonic(args):
+    V, F = read_mesh(args.mesh)
+    b, bc = read_scalar_constraints(args.constraints, V.shape[0])
+    W = igl.harmonic(V, F, b, bc, 1)
+    W = np.asarray(W).reshape(V.shape[0], -1)[:, 0]
+    if not np.all(np.isfinite(W)):
+        raise RuntimeError("harmonic produced non-finite values")
+    write_matrix(args.out, W)
+
+
+# ---------------------------------------------------------------------------------------------
+# eigs
+
+
+def cmd_eigs(args):
+    V, F = read_mesh(args.mesh)
+    n = V.shape[0]
+    if args.k >= n:
+        raise UsageError(f"K={args.k} must be smaller than the vertex count {n}")
+    L = igl.cotmatrix(V, F).tocsc()
+    M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).tocsc()
+    A = (-L).tocsc()
+    # Deterministic start vector so reruns give the same (sign of the) eigenvectors.
+    v0 = np.ones(n) / np.sqrt(n)
+    t0 = time.perf_counter()
+    vals, vecs = spla.eigsh(A, k=args.k, M=M, sigma=-1e-8, which="LM", v0=v0)
+    seconds = time.perf_counter() - t0
+    order = np.argsort(vals)
+    vals = vals[order]
+    vecs = vecs[:, order]
+    write_matrix(args.out, vals)
+    write_matrix(args.out + ".vectors", vecs)
+    print(json.dumps({"seconds": seconds}))
+
+
+# ---------------------------------------------------------------------------------------------
+# constraints (helper)
+
+
+def cmd_constraints(args):
+    V, _ = read_mesh(args.mesh)
+    status = []
+    with open(args.sel) as fh:
+        for line in fh:
+            s = line.strip()
+            if s and not s.startswith("#"):
+                status.append(int(s))
+    if len(status) != V.shape[0]:
+        raise UsageError(f"{args.sel}: {len(status)} entries for {V.shape[0]} vertices")
+    with open(args.deform) as fh:
+        nums = [float(x) for line in fh if not line.strip().startswith("#") for x in line.split()]
+    if len(nums) != 16:
+        raise UsageError(f"{args.deform}: expected a 4x4 matrix, got {len(nums)} numbers")
+    T = np.array(nums).reshape(4, 4)
+    with open(args.out, "w") as fh:
+        for i, s in enumerate(status):
+            if s == 0:
+                p = V[i]
+            elif s == 2:
+                p = (T @ np.append(V[i], 1.0))[:3]
+            elif s == 1:
+                continue
+            else:
+                raise UsageError(f"{args.sel}: unknown status {s} for vertex {i}")
+            fh.write("%d %.17g %.17g %.17g\n" % (i, p[0], p[1], p[2]))
+
+
+# ---------------------------------------------------------------------------------------------
+
+
+def build_parser():
+    p = ArgumentParser(description="libigl/scipy reference results for deformbench.")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=ArgumentParser)
+
+    s = sub.add_parser("operators", help="cotangent Laplacian and mass matrix diagonals")
+    s.add_argument("mesh")
+    s.add_argument("out_dir")
+    s.set_defaults(func=cmd_operators)
+
+    s = sub.add_parser("arap", help="libigl ARAP (SPOKES) deformation")
+    s.add_argument("mesh")
+    s.add_argument("constraints")
+    s.add_argument("iterations", type=positive_int)
+    s.add_argument("out")
+    s.set_defaults(func=cmd_arap)
+
+    s = sub.add_parser("arap-timing", help="time libigl ARAP precomputation and iterations")
+    s.add_argument("mesh")
+    s.add_argument("constraints")
+    s.add_argument("iterations", type=positive_int)
+    s.set_defaults(func=cmd_arap_timing)
+
+    s = sub.add_parser("harmonic", help="igl.harmonic with k=1")
+    s.add_argument("mesh")
+    s.add_argument("constraints")
+    s.add_argument("out")
+    s.set_defaults(func=cmd_harmonic)
+
+    s = sub.add_parser("eigs", help="smallest generalized eigenpairs of (-L, M_voronoi)")
+    s.add_argument("mesh")
+    s.add_argument("k", type=positive_int)
+    s.add_argument("out")
+    s.set_defaults(func=cmd_eigs)
+
+    s = sub.add_parser("constraints", help="ARAP constraints file from a .sel/.def pair")
+    s.add_argument("mesh")
+    s.add_argument("sel")
+    s.add_argument("deform", metavar="def")
+    s.add_argument("out")
+    s.set_defaults(func=cmd_constraints)
+    return p
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
+    try:
+        args.func(args)
+    except (UsageError, RuntimeError, OSError, ValueError) as e:
+        print(f"igl_reference.py {args.command}: error: {e}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
