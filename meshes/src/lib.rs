@@ -5,6 +5,7 @@
 pub mod edit;
 pub mod error;
 pub mod geometry;
+pub mod io;
 pub mod mesh;
 pub mod topology;
 pub mod vector;

@@ -1,0 +1,136 @@
+//! Wavefront OBJ (`.obj`), geometry only.
+//!
+//! Reads the `v` (position) and `f` (face) statements and ignores everything else (`vt`, `vn`, groups,
+//! objects, materials, smoothing groups, lines, points, free-form geometry). Face corners may be written
+//! `v`, `v/vt`, `v//vn` or `v/vt/vn`; only the position index is used, so texture and normal seams do
+//! not split vertices. Indices are 1-based; negative indices count back from the last vertex defined so
+//! far, as the format specifies.
+//!
+//! This is a hand-written parser rather than `tobj` because the benchmark needs the file's vertices
+//! exactly as written: `tobj` (without its `use_f64` feature) rounds positions to `f32`, renumbers
+//! vertices in order of first use and per object/group (which would invalidate a per-vertex `.sel`
+//! selection and disconnect groups), and drops unreferenced vertices.
+
+use std::io::Write;
+use std::path::Path;
+
+use super::{atomic_write, data_lines, read_text, syntax, RoundTrip};
+use crate::error::{MeshError, Result};
+use crate::mesh::TriMesh;
+
+/// Read the OBJ file `path` into a mesh of `#V x 3` positions (every `v`, in file order, including
+/// vertices no face uses) and `#F x 3` triangles (every `f`, in file order, made 0-based).
+///
+/// Errors (all wrapped in [`MeshError::InFile`]): [`MeshError::Syntax`] with the line for a malformed
+/// number, too few coordinates, a rational vertex (`w != 1`), an index of 0 or a relative index before
+/// the first vertex; [`MeshError::NotATriangle`] for a face with other than 3 corners (no
+/// triangulation); and the validation errors of [`TriMesh::new`] (non-finite coordinate naming the
+/// vertex, out-of-range index naming the face).
+pub fn read_obj(path: impl AsRef<Path>) -> Result<TriMesh> {
+    let path = path.as_ref();
+    read_text(path).and_then(|text| parse_obj(&text)).map_err(|e| e.in_file(path))
+}
+
+/// Parse OBJ `text` (the content of a file, see [`read_obj`]) into a mesh. Errors are not wrapped with
+/// a file name.
+pub fn parse_obj(text: &str) -> Result<TriMesh> {
+    let mut positions: Vec<[f64; 3]> = Vec::new();
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    for (line, content) in data_lines(text) {
+        let mut tokens = content.split_ascii_whitespace();
+        match tokens.next() {
+            Some("v") => {
+                let v = positions.len();
+                let values: Vec<&str> = tokens.collect();
+                let mut p = [0.0f64; 3];
+                for (axis, slot) in p.iter_mut().enumerate() {
+                    let token = values.get(axis).ok_or_else(|| {
+                        syntax(line, format!("vertex {v}: expected 3 coordinates, found {}", values.len()))
+                    })?;
+                    *slot = parse_number(token, v, line)?;
+                }
+                // Exactly four values is `x y z w`; six or seven are `x y z r g b [a]` (colors, ignored).
+                if let [_, _, _, w] = values[..] {
+                    let w = parse_number(w, v, line)?;
+                    if w != 1.0 {
+                        return Err(syntax(
+                            line,
+                            format!("vertex {v}: rational vertices (w = {w}) are not supported"),
+                        ));
+                    }
+                }
+                positions.push(p);
+            }
+            Some("f") => {
+                let f = triangles.len();
+                let corners: Vec<&str> = tokens.collect();
+                let [a, b, c] = corners[..] else {
+                    return Err(MeshError::NotATriangle { face: f, corners: corners.len() });
+                };
+                let n = positions.len();
+                triangles.push([
+                    parse_corner(a, f, n, line)?,
+                    parse_corner(b, f, n, line)?,
+                    parse_corner(c, f, n, line)?,
+                ]);
+            }
+            _ => {}
+        }
+    }
+    TriMesh::new(positions, triangles)
+}
+
+/// Write `mesh` (`#V x 3` positions, `#F x 3` triangles) to `path` as OBJ `v` and `f` lines (1-based),
+/// every coordinate with round-trip precision. Atomic, see [`atomic_write`]; errors name the file.
+pub fn write_obj(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
+    atomic_write(path, |w| write_obj_to(w, mesh))
+}
+
+fn write_obj_to(w: &mut dyn Write, mesh: &TriMesh) -> Result<()> {
+    writeln!(w, "# {} vertices, {} triangles", mesh.n_vertices(), mesh.n_faces())?;
+    for p in mesh.positions() {
+        writeln!(w, "v {} {} {}", RoundTrip(p[0]), RoundTrip(p[1]), RoundTrip(p[2]))?;
+    }
+    for t in mesh.triangles() {
+        writeln!(w, "f {} {} {}", u64::from(t[0]) + 1, u64::from(t[1]) + 1, u64::from(t[2]) + 1)?;
+    }
+    Ok(())
+}
+
+fn parse_number(token: &str, vertex: usize, line: usize) -> Result<f64> {
+    // Non-finite values ("nan", "inf") parse here and are rejected by TriMesh::new, naming the vertex.
+    token.parse().map_err(|_| syntax(line, format!("vertex {vertex}: coordinate '{token}' is not a number")))
+}
+
+/// The 0-based position index of a face corner `v[/vt[/vn]]`, resolving negative (relative) indices
+/// against the `n_defined` vertices read so far.
+fn parse_corner(token: &str, face: usize, n_defined: usize, line: usize) -> Result<u32> {
+    let v = token.split('/').next().unwrap_or(token);
+    let i: i64 = v
+        .parse()
+        .map_err(|_| syntax(line, format!("face {face}: vertex index '{token}' is not an integer")))?;
+    let zero_based = match i {
+        0 => {
+            return Err(syntax(
+                line,
+                format!("face {face}: vertex index 0 is invalid (OBJ indices start at 1)"),
+            ))
+        }
+        i if i > 0 => i - 1,
+        i => {
+            let resolved = i64::try_from(n_defined).unwrap_or(i64::MAX).saturating_add(i);
+            if resolved < 0 {
+                return Err(syntax(
+                    line,
+                    format!("face {face}: relative vertex index {i} points before the first vertex ({n_defined} defined so far)"),
+                ));
+            }
+            resolved
+        }
+    };
+    u32::try_from(zero_based).map_err(|_| MeshError::IndexOutOfRange {
+        face,
+        index: zero_based as u64,
+        n_vertices: n_defined,
+    })
+}
