@@ -7,6 +7,7 @@ pub mod error;
 pub mod geometry;
 pub mod io;
 pub mod mesh;
+pub mod shapes;
 pub mod topology;
 pub mod vector;
 
