@@ -1,1 +1,13 @@
+//! The deformbench harness: scenarios and method parameters from `configs/`, running every method
+//! through its phases with timings, quality metrics, and reports in `reports/`.
 
+pub mod case;
+pub mod cli;
+pub mod config;
+pub mod error;
+pub mod metrics;
+pub mod report;
+pub mod scenario;
+pub mod suite;
+
+pub use error::HarnessError;

@@ -7,12 +7,8 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
     /// An error that happened while reading or writing `path`.
-    #[error("{}: {source}", path.display())]
-    InFile {
-        path: PathBuf,
-        #[source]
-        source: Box<MeshError>,
-    },
+    #[error("{}: {error}", path.display())]
+    InFile { path: PathBuf, error: Box<MeshError> },
     /// A text file could not be parsed at `line` (1-based).
     #[error("line {line}: {message}")]
     Syntax { line: usize, message: String },
@@ -20,7 +16,7 @@ pub enum MeshError {
     #[error("unexpected end of file: {expected}")]
     Truncated { expected: String },
     /// An operating-system I/O error.
-    #[error("{0}")]
+    #[error(transparent)]
     Io(#[from] std::io::Error),
     /// A binary or third-party format reported an error.
     #[error("{0}")]
@@ -62,7 +58,7 @@ impl MeshError {
     pub fn in_file(self, path: impl Into<PathBuf>) -> MeshError {
         match self {
             e @ MeshError::InFile { .. } => e,
-            e => MeshError::InFile { path: path.into(), source: Box::new(e) },
+            e => MeshError::InFile { path: path.into(), error: Box::new(e) },
         }
     }
 }

@@ -165,3 +165,56 @@ fn boundary_loops(
     }
     loops
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two triangles sharing the diagonal of the unit square.
+    fn square() -> TriMesh {
+        TriMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn square_adjacency() {
+        let t = Topology::new(&square()).unwrap();
+        assert_eq!(t.edges(), &[[0, 1], [0, 2], [0, 3], [1, 2], [2, 3]]);
+        let diagonal = t.edges().iter().position(|e| *e == [0, 2]).unwrap();
+        assert_eq!(t.edge_faces()[diagonal], [0, 1]);
+        assert_eq!(t.interior_edges().collect::<Vec<_>>(), vec![diagonal]);
+        assert_eq!(t.one_ring(0), &[1, 2, 3]);
+        assert_eq!(t.one_ring(1), &[0, 2]);
+        assert_eq!(t.boundary_loops(), &[vec![0, 1, 2, 3]]);
+        // face_edges[f][k] is the edge opposite corner k.
+        assert_eq!(t.edges()[t.face_edges()[0][1] as usize], [0, 2]);
+        assert!(!t.is_closed());
+    }
+
+    #[test]
+    fn tetrahedron_is_closed() {
+        let m = TriMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+        )
+        .unwrap();
+        let t = Topology::new(&m).unwrap();
+        assert!(t.is_closed());
+        assert_eq!(t.interior_edges().count(), 6);
+    }
+
+    #[test]
+    fn non_manifold_and_misoriented_meshes_are_rejected() {
+        let p = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]];
+        let fan = TriMesh::new(p.clone(), vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]]).unwrap();
+        assert!(matches!(Topology::new(&fan), Err(MeshError::NonManifoldEdge { a: 0, b: 1, .. })));
+        let flipped = TriMesh::new(p, vec![[0, 1, 2], [0, 1, 3]]).unwrap();
+        assert!(matches!(
+            Topology::new(&flipped),
+            Err(MeshError::InconsistentOrientation { a: 0, b: 1, .. })
+        ));
+    }
+}

@@ -37,7 +37,7 @@ fn unwrap_in_file<T: std::fmt::Debug>(
         assert!(message.contains(needle), "message lacks '{needle}': {message}");
     }
     match err {
-        MeshError::InFile { path: p, source } => {
+        MeshError::InFile { path: p, error: source } => {
             assert_eq!(p, path);
             *source
         }

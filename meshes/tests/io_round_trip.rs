@@ -282,7 +282,7 @@ fn write_into_missing_directory_fails_and_creates_nothing() {
         let path = missing.join(name);
         let err = write_mesh(&path, &mesh).unwrap_err();
         match &err {
-            MeshError::InFile { path: p, source } => {
+            MeshError::InFile { path: p, error: source } => {
                 assert_eq!(p, &path);
                 assert!(matches!(**source, MeshError::Io(ref e) if e.kind() == std::io::ErrorKind::NotFound));
             }

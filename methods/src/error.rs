@@ -15,10 +15,17 @@ pub enum MethodError {
     Targets(String),
     #[error("`{method}`: {phase} called before {missing}")]
     Phase { method: &'static str, phase: &'static str, missing: &'static str },
-    #[error("mesh: {0}")]
+    #[error(transparent)]
     Mesh(#[from] meshes::MeshError),
+    // Not `#[from]`: that would also make it the error's source, and chains would print it twice.
     #[error("linear solver: {0}")]
-    Solver(#[from] SolverError),
+    Solver(SolverError),
     #[error("`{method}` produced a non-finite position at vertex {vertex} in iteration {iteration}")]
     NonFinite { method: &'static str, vertex: usize, iteration: usize },
+}
+
+impl From<SolverError> for MethodError {
+    fn from(e: SolverError) -> Self {
+        MethodError::Solver(e)
+    }
 }

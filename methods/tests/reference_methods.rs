@@ -1,0 +1,180 @@
+//! Properties of the reference methods `laplacian` and `arap` that must hold on any mesh:
+//! fixed points, rigid invariance, constraint satisfaction, incremental binding, determinism, and
+//! clear errors for bad input.
+
+use meshes::shapes::{generate, ShapeKind};
+use meshes::{AffineTransform, TriMesh, VertexStatus};
+use methods::registry::create;
+use methods::{HandleRegion, HandleSet, HandleTargets, MethodError, NoObserver};
+
+const REFERENCE: [&str; 2] = ["laplacian", "arap"];
+
+fn params(text: &str) -> toml::Table {
+    text.parse().unwrap()
+}
+
+/// Procedural bar (~1.5K vertices) with its survey-style fixed and handle regions.
+fn bar() -> (TriMesh, HandleSet, Vec<u32>, Vec<u32>) {
+    let shape = generate(ShapeKind::Bar, 1500).unwrap();
+    let fixed = meshes::edit::vertices_with_status(&shape.selection, VertexStatus::Fixed);
+    let handle = meshes::edit::vertices_with_status(&shape.selection, VertexStatus::Handle);
+    let handles = HandleSet::new(
+        vec![
+            HandleRegion { name: "fixed".into(), vertices: fixed.clone() },
+            HandleRegion { name: "handle".into(), vertices: handle.clone() },
+        ],
+        shape.mesh.n_vertices(),
+    )
+    .unwrap();
+    (shape.mesh, handles, fixed, handle)
+}
+
+fn targets_by(mesh: &TriMesh, handles: &HandleSet, f: impl Fn(u32, [f64; 3]) -> [f64; 3]) -> HandleTargets {
+    let t = handles.constrained().map(|v| f(v, mesh.positions()[v as usize])).collect();
+    HandleTargets::new(handles, t).unwrap()
+}
+
+fn max_distance(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    methods::method::max_displacement(a, b)
+}
+
+fn run(name: &str, p: &str, mesh: &TriMesh, handles: &HandleSet, targets: &HandleTargets) -> Vec<[f64; 3]> {
+    let mut m = create(name, &params(p)).unwrap();
+    m.precompute(mesh).unwrap();
+    m.bind_handles(handles).unwrap();
+    m.solve(targets, &mut NoObserver).unwrap();
+    m.positions()
+}
+
+#[test]
+fn rest_shape_is_a_fixed_point() {
+    let (mesh, handles, _, _) = bar();
+    let targets = targets_by(&mesh, &handles, |_, p| p);
+    for name in REFERENCE {
+        let x = run(name, "", &mesh, &handles, &targets);
+        let d = max_distance(&x, mesh.positions()) / mesh.bbox_diagonal();
+        assert!(d < 1e-9, "{name}: rest shape moved by {d:e} x diagonal");
+    }
+}
+
+#[test]
+fn rigid_motion_of_all_handles_moves_the_mesh_rigidly() {
+    let (mesh, handles, _, _) = bar();
+    let rigid = AffineTransform::rotation_about([0.3, 1.0, 0.2], 0.5, [1.0, 2.0, 40.0])
+        .compose(&AffineTransform::translation([3.0, -1.0, 2.0]));
+    let targets = targets_by(&mesh, &handles, |_, p| rigid.apply(p));
+    let expected: Vec<[f64; 3]> = mesh.positions().iter().map(|&p| rigid.apply(p)).collect();
+    for (name, p, tol) in [
+        ("arap", "max_iterations = 300\ntolerance = 1e-10", 1e-6),
+        ("laplacian", "max_iterations = 3000\ntolerance = 1e-10", 1e-4),
+    ] {
+        let x = run(name, p, &mesh, &handles, &targets);
+        let d = max_distance(&x, &expected) / mesh.bbox_diagonal();
+        assert!(d < tol, "{name}: result is {d:e} x diagonal from the rigidly moved mesh");
+    }
+}
+
+#[test]
+fn handle_constraints_are_met() {
+    let (mesh, handles, _, handle) = bar();
+    let twist = AffineTransform::rotation_about([0.0, 0.0, 1.0], 1.0, [0.0, 0.0, 0.0]);
+    let targets = targets_by(&mesh, &handles, |v, p| if handle.contains(&v) { twist.apply(p) } else { p });
+    let diag = mesh.bbox_diagonal();
+    for (name, tol) in [("arap", 1e-9), ("laplacian", 1e-3)] {
+        let x = run(name, "", &mesh, &handles, &targets);
+        let worst = handles
+            .constrained()
+            .zip(targets.positions())
+            .map(|(v, t)| meshes::vector::norm(meshes::vector::sub(x[v as usize], *t)))
+            .fold(0.0, f64::max)
+            / diag;
+        assert!(worst <= tol, "{name}: handle residual {worst:e} x diagonal");
+    }
+}
+
+#[test]
+fn rebinding_mid_edit_keeps_the_current_shape() {
+    let (mesh, handles, fixed, handle) = bar();
+    let lift = AffineTransform::translation([0.0, 5.0, 0.0]);
+    let targets = targets_by(&mesh, &handles, |v, p| if handle.contains(&v) { lift.apply(p) } else { p });
+    for name in REFERENCE {
+        let mut m = create(name, &toml::Table::new()).unwrap();
+        m.precompute(&mesh).unwrap();
+        m.bind_handles(&handles).unwrap();
+        m.solve(&targets, &mut NoObserver).unwrap();
+        let before = m.positions();
+        // Second step: a different handle set (the fixed region and every other handle vertex), held
+        // where the first step left them. Binding must not move anything, and the solve starts from the
+        // deformed shape, so the lifted end stays lifted (from the rest shape it would not).
+        let half: Vec<u32> = handle.iter().copied().step_by(2).collect();
+        let second = HandleSet::new(
+            vec![
+                HandleRegion { name: "fixed".into(), vertices: fixed.clone() },
+                HandleRegion { name: "half".into(), vertices: half.clone() },
+            ],
+            mesh.n_vertices(),
+        )
+        .unwrap();
+        m.bind_handles(&second).unwrap();
+        assert_eq!(m.positions(), before, "{name}: binding changed the shape");
+        let hold =
+            HandleTargets::new(&second, second.constrained().map(|v| before[v as usize]).collect()).unwrap();
+        m.solve(&hold, &mut NoObserver).unwrap();
+        let after = m.positions();
+        let lifted =
+            handle.iter().map(|&v| after[v as usize][1] - mesh.positions()[v as usize][1]).sum::<f64>()
+                / handle.len() as f64;
+        assert!(lifted > 4.5, "{name}: second step forgot the first (mean lift {lifted} of 5)");
+    }
+}
+
+#[test]
+fn results_are_deterministic() {
+    let (mesh, handles, _, handle) = bar();
+    let twist = AffineTransform::rotation_about([0.0, 0.0, 1.0], 2.0, [0.0, 0.0, 0.0]);
+    let targets = targets_by(&mesh, &handles, |v, p| if handle.contains(&v) { twist.apply(p) } else { p });
+    for name in REFERENCE {
+        let a = run(name, "max_iterations = 20", &mesh, &handles, &targets);
+        let b = run(name, "max_iterations = 20", &mesh, &handles, &targets);
+        assert!(a == b, "{name}: two runs differ");
+    }
+}
+
+#[test]
+fn bad_handle_sets_are_rejected_with_their_element() {
+    let n = 10;
+    let region = |name: &str, v: &[u32]| HandleRegion { name: name.into(), vertices: v.to_vec() };
+    let msg = |r: Result<HandleSet, MethodError>| r.unwrap_err().to_string();
+    assert!(msg(HandleSet::new(vec![], n)).contains("no handle regions"));
+    assert!(msg(HandleSet::new(vec![region("a", &[])], n)).contains("`a` has no vertices"));
+    assert!(msg(HandleSet::new(vec![region("a", &[3, 10])], n)).contains("vertex 10 is out of range"));
+    assert!(msg(HandleSet::new(vec![region("a", &[3, 3])], n)).contains("lists vertex 3 twice"));
+    assert!(msg(HandleSet::new(vec![region("a", &[1, 2]), region("b", &[2])], n))
+        .contains("vertex 2 is in both handle `a` and handle `b`"));
+    let set = HandleSet::new(vec![region("a", &[1, 2])], n).unwrap();
+    assert!(HandleTargets::new(&set, vec![[0.0; 3]]).unwrap_err().to_string().contains("1 targets for 2"));
+    assert!(HandleTargets::new(&set, vec![[0.0; 3], [f64::NAN, 0.0, 0.0]])
+        .unwrap_err()
+        .to_string()
+        .contains("vertex 2 is not finite"));
+}
+
+#[test]
+fn unknown_methods_parameters_and_phase_order_are_errors() {
+    let e = create("no_such_method", &toml::Table::new()).err().unwrap().to_string();
+    assert!(e.contains("unknown method `no_such_method`") && e.contains("arap"), "{e}");
+    let e = create("arap", &params("max_iteratons = 3")).err().unwrap().to_string();
+    assert!(e.contains("max_iteratons"), "{e}");
+    let e = create("laplacian", &params("omega = -1.0")).err().unwrap().to_string();
+    assert!(e.contains("omega"), "{e}");
+    let (mesh, handles, _, _) = bar();
+    for name in REFERENCE {
+        let mut m = create(name, &toml::Table::new()).unwrap();
+        assert!(matches!(m.bind_handles(&handles), Err(MethodError::Phase { .. })));
+        m.precompute(&mesh).unwrap();
+        let targets = targets_by(&mesh, &handles, |_, p| p);
+        assert!(matches!(m.solve(&targets, &mut NoObserver), Err(MethodError::Phase { .. })));
+        let other = HandleSet::new(vec![HandleRegion { name: "a".into(), vertices: vec![0] }], 5).unwrap();
+        assert!(m.bind_handles(&other).is_err(), "{name}: handle set for another mesh accepted");
+    }
+}

@@ -1,0 +1,320 @@
+//! End-to-end tests of `harness all`: reports on the survey data and on the procedural look-alikes,
+//! and every kind of bad input rejected with an error that names the file and element, leaving the
+//! reports directory untouched.
+
+mod support;
+
+use std::path::{Path, PathBuf};
+
+use meshes::shapes::{generate, ShapeKind};
+
+fn run(args: &[&str]) -> anyhow::Result<std::process::ExitCode> {
+    let mut full = vec!["harness"];
+    full.extend_from_slice(args);
+    harness::cli::run(full)
+}
+
+fn csv_rows(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let headers = reader.headers().unwrap().clone();
+    reader
+        .records()
+        .map(|r| headers.iter().map(String::from).zip(r.unwrap().iter().map(String::from)).collect())
+        .collect()
+}
+
+fn num(row: &std::collections::HashMap<String, String>, key: &str) -> f64 {
+    row[key].parse().unwrap_or_else(|_| panic!("{key} = {:?} is not a number", row[key]))
+}
+
+#[test]
+fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
+    let Some(survey) = support::survey_dir() else { return };
+    let reports = tempfile::tempdir().unwrap();
+    let code = run(&[
+        "all",
+        "--quiet",
+        "--survey-dir",
+        survey.to_str().unwrap(),
+        "--reports",
+        reports.path().to_str().unwrap(),
+    ])
+    .unwrap();
+    assert_eq!(code, std::process::ExitCode::SUCCESS);
+    let rows = csv_rows(&reports.path().join("results.csv"));
+    for scenario in ["bar", "cactus", "cylinder", "plane"] {
+        for method in ["laplacian", "arap"] {
+            let row = rows
+                .iter()
+                .find(|r| r["scenario"] == scenario && r["method"] == method)
+                .unwrap_or_else(|| panic!("no row for {scenario} / {method}"));
+            assert_eq!(row["status"], "ok", "{scenario}/{method}");
+            assert_eq!(row["mesh_source"], "survey");
+            let residual = num(row, "handle_residual_over_diag");
+            let bound = if method == "arap" { 1e-9 } else { 1e-3 };
+            assert!(residual <= bound, "{scenario}/{method}: handle residual {residual:e} > {bound:e}");
+            for key in [
+                "e_theta_deg",
+                "e_phi_deg",
+                "precompute_s",
+                "bind_s",
+                "median_iteration_ms",
+                "rms_to_arap_over_diag",
+            ] {
+                let v = num(row, key);
+                assert!(v.is_finite() && v >= 0.0, "{scenario}/{method}: {key} = {v}");
+            }
+            let off = reports.path().join(format!("meshes/{scenario}-{method}.off"));
+            let glb = reports.path().join(format!("meshes/{scenario}-{method}.glb"));
+            let result = meshes::io::read_mesh(&off).unwrap();
+            assert_eq!(result.n_vertices(), row["vertices"].parse::<usize>().unwrap());
+            assert_eq!(meshes::io::read_mesh(&glb).unwrap().n_faces(), result.n_faces());
+        }
+        let arap = rows.iter().find(|r| r["scenario"] == scenario && r["method"] == "arap").unwrap();
+        assert_eq!(num(arap, "rms_to_arap_over_diag"), 0.0);
+    }
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(reports.path().join("results.json")).unwrap()).unwrap();
+    let cases = json["cases"].as_array().unwrap();
+    assert_eq!(cases.len(), rows.len());
+    assert!(cases.iter().all(|c| !c["trace"].as_array().unwrap().is_empty()));
+}
+
+#[test]
+fn without_survey_data_the_procedural_look_alikes_run_and_are_labelled() {
+    let reports = tempfile::tempdir().unwrap();
+    let configs = tempfile::tempdir().unwrap();
+    // Small look-alikes keep the test quick; the shapes are the same generators `all` uses.
+    std::fs::create_dir(configs.path().join("scenarios")).unwrap();
+    std::fs::copy(
+        support::workspace_root().join("configs/methods.toml"),
+        configs.path().join("methods.toml"),
+    )
+    .unwrap();
+    for shape in ["bar", "cylinder", "cactus", "plane"] {
+        std::fs::write(
+            configs.path().join(format!("scenarios/{shape}.toml")),
+            // No `survey` key: DEFORM_SURVEY_DIR may be set in the environment of the test run.
+            format!("name = \"{shape}\"\nprocedural = {{ shape = \"{shape}\", vertices = 1500 }}\n"),
+        )
+        .unwrap();
+    }
+    let code = run(&[
+        "all",
+        "--quiet",
+        "--configs",
+        configs.path().to_str().unwrap(),
+        "--reports",
+        reports.path().to_str().unwrap(),
+    ])
+    .unwrap();
+    assert_eq!(code, std::process::ExitCode::SUCCESS);
+    let rows = csv_rows(&reports.path().join("results.csv"));
+    assert_eq!(rows.len(), 8);
+    for row in &rows {
+        assert_eq!(row["mesh_source"], "procedural look-alike");
+        assert_eq!(row["status"], "ok", "{}/{}", row["scenario"], row["method"]);
+    }
+    let json = std::fs::read_to_string(reports.path().join("results.json")).unwrap();
+    assert!(json.contains("procedural look-alikes"));
+}
+
+/// A tiny survey-format data set (procedural bar written as .off/.sel/.def) and a configs directory
+/// with one scenario using it, plus a reports directory holding a sentinel file.
+struct BadInputFixture {
+    _root: tempfile::TempDir,
+    data: PathBuf,
+    configs: PathBuf,
+    reports: PathBuf,
+}
+
+impl BadInputFixture {
+    fn new() -> Self {
+        let root = tempfile::tempdir().unwrap();
+        let data = root.path().join("data");
+        let configs = root.path().join("configs");
+        let reports = root.path().join("reports");
+        for d in [&data, &configs.join("scenarios"), &reports] {
+            std::fs::create_dir_all(d).unwrap();
+        }
+        let shape = generate(ShapeKind::Bar, 500).unwrap();
+        meshes::io::write_off(data.join("tiny.off"), &shape.mesh).unwrap();
+        meshes::io::write_selection(data.join("tiny.sel"), &shape.selection).unwrap();
+        meshes::io::write_transform(data.join("tiny.def"), &shape.transform).unwrap();
+        std::fs::write(configs.join("methods.toml"), "[arap]\nmax_iterations = 3\n").unwrap();
+        std::fs::write(configs.join("scenarios/tiny.toml"), "name = \"tiny\"\nsurvey = \"tiny\"\n").unwrap();
+        std::fs::write(reports.join("sentinel.txt"), "untouched").unwrap();
+        Self { _root: root, data, configs, reports }
+    }
+
+    fn file(&self, name: &str) -> PathBuf {
+        self.data.join(name)
+    }
+
+    /// Replace the `line`-th line (1-based) of a data file.
+    fn edit_line(&self, name: &str, line: usize, new: &str) {
+        let text = std::fs::read_to_string(self.file(name)).unwrap();
+        let mut lines: Vec<String> = text.lines().map(String::from).collect();
+        lines[line - 1] = new.to_string();
+        std::fs::write(self.file(name), lines.join("\n") + "\n").unwrap();
+    }
+
+    /// Run `all`; it must fail with a message containing every one of `needles`, and write nothing.
+    fn expect_error(&self, needles: &[&str]) {
+        let result = run(&[
+            "all",
+            "--quiet",
+            "--survey-dir",
+            self.data.to_str().unwrap(),
+            "--configs",
+            self.configs.to_str().unwrap(),
+            "--reports",
+            self.reports.to_str().unwrap(),
+        ]);
+        let message = format!("{:#}", result.expect_err("bad input must be an error"));
+        for needle in needles {
+            assert!(message.contains(needle), "error {message:?} does not mention {needle:?}");
+        }
+        let written: Vec<_> =
+            std::fs::read_dir(&self.reports).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(written, vec![std::ffi::OsString::from("sentinel.txt")], "reports/ was written to");
+    }
+}
+
+/// Line number (1-based) of the first vertex and first face of an OFF written by `write_off`.
+fn off_layout(path: &Path) -> (usize, usize, usize) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let counts = lines.iter().position(|l| l.split_whitespace().count() == 3 && !l.starts_with('#')).unwrap();
+    let nv: usize = lines[counts].split_whitespace().next().unwrap().parse().unwrap();
+    (counts + 2, counts + 2 + nv, nv)
+}
+
+#[test]
+fn fixture_is_valid() {
+    let f = BadInputFixture::new();
+    let code = run(&[
+        "all",
+        "--quiet",
+        "--survey-dir",
+        f.data.to_str().unwrap(),
+        "--configs",
+        f.configs.to_str().unwrap(),
+        "--reports",
+        f.reports.to_str().unwrap(),
+    ])
+    .unwrap();
+    assert_eq!(code, std::process::ExitCode::SUCCESS);
+}
+
+#[test]
+fn malformed_number_names_file_and_line() {
+    let f = BadInputFixture::new();
+    let (first_vertex, _, _) = off_layout(&f.file("tiny.off"));
+    f.edit_line("tiny.off", first_vertex + 3, "1.0 abc 2.0");
+    f.expect_error(&["tiny.off", &format!("line {}", first_vertex + 3)]);
+}
+
+#[test]
+fn truncated_off_is_rejected() {
+    let f = BadInputFixture::new();
+    let text = std::fs::read_to_string(f.file("tiny.off")).unwrap();
+    let keep: Vec<&str> = text.lines().collect();
+    std::fs::write(f.file("tiny.off"), keep[..keep.len() - 10].join("\n")).unwrap();
+    f.expect_error(&["tiny.off", "end of file"]);
+}
+
+#[test]
+fn out_of_range_index_names_the_face() {
+    let f = BadInputFixture::new();
+    let (_, first_face, nv) = off_layout(&f.file("tiny.off"));
+    f.edit_line("tiny.off", first_face + 5, &format!("3 0 1 {}", nv + 7));
+    f.expect_error(&["tiny.off", "face 5", &format!("{}", nv + 7), "out of range"]);
+}
+
+#[test]
+fn nan_coordinate_names_the_vertex() {
+    let f = BadInputFixture::new();
+    let (first_vertex, _, _) = off_layout(&f.file("tiny.off"));
+    f.edit_line("tiny.off", first_vertex + 4, "0.5 NaN 1.0");
+    f.expect_error(&["tiny.off", "vertex 4", "NaN"]);
+}
+
+#[test]
+fn zero_area_triangle_names_the_face() {
+    let f = BadInputFixture::new();
+    let mesh = meshes::io::read_mesh(f.file("tiny.off")).unwrap();
+    // Move a vertex onto the midpoint of the opposite edge of its first face: that face has zero area.
+    let [a, b, c] = mesh.triangles()[0];
+    let mut p = mesh.positions().to_vec();
+    let (pb, pc) = (p[b as usize], p[c as usize]);
+    p[a as usize] = [(pb[0] + pc[0]) / 2.0, (pb[1] + pc[1]) / 2.0, (pb[2] + pc[2]) / 2.0];
+    meshes::io::write_off(f.file("tiny.off"), &mesh.with_positions(p).unwrap()).unwrap();
+    f.expect_error(&["tiny.off", "face 0", "zero area"]);
+}
+
+#[test]
+fn non_manifold_edge_is_rejected() {
+    let f = BadInputFixture::new();
+    let mesh = meshes::io::read_mesh(f.file("tiny.off")).unwrap();
+    // An interior edge (the bar is open at the bottom, so avoid face 0 on the rim).
+    let [a, b, _] = mesh.triangles()[mesh.n_faces() / 2];
+    // The vertex making the largest triangle with (a, b), so the new face is not degenerate.
+    let p = mesh.positions();
+    let area = |v: u32| meshes::geometry::triangle_area(p, &[a, b, v]);
+    let other = (0..mesh.n_vertices() as u32).max_by(|&u, &v| area(u).total_cmp(&area(v))).unwrap();
+    // A third face on edge (a, b) (both orientations are taken already by the two existing faces).
+    let mut tris = mesh.triangles().to_vec();
+    tris.push([a, b, other]);
+    let bad = meshes::TriMesh::new(mesh.positions().to_vec(), tris).unwrap();
+    meshes::io::write_off(f.file("tiny.off"), &bad).unwrap();
+    f.expect_error(&["tiny.off", "non-manifold", &format!("({}, {})", a.min(b), a.max(b))]);
+}
+
+#[test]
+fn selection_of_wrong_length_is_rejected() {
+    let f = BadInputFixture::new();
+    let text = std::fs::read_to_string(f.file("tiny.sel")).unwrap();
+    std::fs::write(f.file("tiny.sel"), text + "1\n").unwrap();
+    f.expect_error(&["tiny.sel", "entries but the mesh has"]);
+}
+
+#[test]
+fn transform_that_is_not_4x4_is_rejected() {
+    let f = BadInputFixture::new();
+    std::fs::write(f.file("tiny.def"), "# 4x4\n1 0 0 0\n0 1 0 0\n0 0 1 0\n").unwrap();
+    f.expect_error(&["tiny.def"]);
+}
+
+#[test]
+fn empty_handle_set_is_rejected() {
+    let f = BadInputFixture::new();
+    let text = std::fs::read_to_string(f.file("tiny.sel")).unwrap();
+    std::fs::write(f.file("tiny.sel"), text.replace('2', "1")).unwrap();
+    f.expect_error(&["scenario `tiny`", "no handle vertices"]);
+}
+
+#[test]
+fn scenario_naming_an_unknown_method_is_rejected() {
+    let f = BadInputFixture::new();
+    std::fs::write(
+        f.configs.join("scenarios/tiny.toml"),
+        "name = \"tiny\"\nsurvey = \"tiny\"\nmethods = [\"arap\", \"hirn\"]\n",
+    )
+    .unwrap();
+    f.expect_error(&["tiny.toml", "unknown method `hirn`"]);
+}
+
+#[test]
+fn unknown_method_parameter_is_rejected() {
+    let f = BadInputFixture::new();
+    std::fs::write(f.configs.join("methods.toml"), "[arap]\nmax_iter = 3\n").unwrap();
+    f.expect_error(&["methods.toml", "max_iter"]);
+}
+
+#[test]
+fn missing_survey_directory_is_rejected() {
+    let f = BadInputFixture::new();
+    std::fs::remove_file(f.file("tiny.off")).unwrap();
+    f.expect_error(&["tiny.off"]);
+}

@@ -1,0 +1,74 @@
+//! Shared by the workspace tests: where the survey data and the cross-check Python are, and how to
+//! call the reference scripts.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Set by `scripts/test`: missing data or Python is a failure, not a skip.
+fn required() -> bool {
+    std::env::var("DEFORMBENCH_REQUIRE_CROSSCHECK").is_ok_and(|v| v == "1")
+}
+
+fn unavailable(what: &str) -> Option<PathBuf> {
+    if required() {
+        panic!("{what} is required (DEFORMBENCH_REQUIRE_CROSSCHECK=1) but not available");
+    }
+    eprintln!("SKIPPED: {what} not available; run scripts/test to include this check");
+    None
+}
+
+pub fn workspace_root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The survey data directory: `$DEFORM_SURVEY_DIR`, else `../shared/deformation-survey`.
+pub fn survey_dir() -> Option<PathBuf> {
+    let dir = std::env::var_os("DEFORM_SURVEY_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| workspace_root().join("../shared/deformation-survey"));
+    if dir.join("bar.off").is_file() {
+        Some(dir)
+    } else {
+        unavailable("the survey data (DEFORM_SURVEY_DIR)")
+    }
+}
+
+/// The cross-check interpreter: `$DEFORMBENCH_PYTHON` (set up by scripts/python-env).
+pub fn python() -> Option<PathBuf> {
+    match std::env::var_os("DEFORMBENCH_PYTHON") {
+        Some(p) if Path::new(&p).exists() => Some(PathBuf::from(p)),
+        _ => unavailable("the cross-check Python (DEFORMBENCH_PYTHON)"),
+    }
+}
+
+/// Run `tests/crosscheck/igl_reference.py` with `args`; panics with its stderr on failure. Returns stdout.
+pub fn igl_reference(python: &Path, args: &[&str]) -> String {
+    let script = workspace_root().join("tests/crosscheck/igl_reference.py");
+    let out = Command::new(python).arg(&script).args(args).output().expect("run python");
+    assert!(
+        out.status.success(),
+        "igl_reference.py {args:?} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("utf-8")
+}
+
+/// Whitespace-separated numbers per non-empty line.
+pub fn read_rows(path: &Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .lines()
+        .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
+        .map(|l| l.split_whitespace().map(|x| x.parse().expect("number")).collect())
+        .collect()
+}
+
+/// A survey test case: mesh, handle set and targets from its .off/.sel/.def.
+pub fn survey_case(dir: &Path, name: &str) -> (meshes::TriMesh, methods::HandleSet, methods::HandleTargets) {
+    let mesh = meshes::io::read_mesh(dir.join(format!("{name}.off"))).expect("mesh");
+    let sel = meshes::io::read_selection(dir.join(format!("{name}.sel")), mesh.n_vertices()).expect("sel");
+    let def = meshes::io::read_transform(dir.join(format!("{name}.def"))).expect("def");
+    let (handles, targets) = harness::scenario::survey_edit(&mesh, &sel, &def).expect("edit");
+    (mesh, handles, targets)
+}
