@@ -28,7 +28,7 @@ use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets, FREE};
 use crate::method::{check_finite, DeformationMethod, IterationObserver, IterationReport, SolveSummary};
 use crate::operators::cotan_laplacian;
-use crate::rotation_fit::{closest_rotation, Mat3};
+use crate::rotation_fit::{closest_rotation_warm, Mat3};
 use crate::sparse_cholesky::SparseCholesky;
 
 /// Parameters of [`Arap`] (configs/methods.toml, section `[arap]`).
@@ -67,6 +67,8 @@ pub struct Arap {
     handles: Option<HandleSet>,
     current: Vec<[f64; 3]>,
     rotations: Vec<Mat3>,
+    /// Right singular vectors of each vertex's covariance, the warm start of the next local step.
+    singular_frames: Vec<Mat3>,
     rhs_rows: Vec<[f64; 3]>,
     rhs: Mat<f64>,
 }
@@ -90,6 +92,7 @@ impl Arap {
             handles: None,
             current: Vec::new(),
             rotations: Vec::new(),
+            singular_frames: Vec::new(),
             rhs_rows: Vec::new(),
             rhs: Mat::zeros(0, 3),
         })
@@ -100,23 +103,25 @@ impl Arap {
         &self.rotations
     }
 
-    fn local_step(spokes: &Spokes, current: &[[f64; 3]], rotations: &mut [Mat3]) {
-        rotations.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, r)| {
-            let xi = current[i];
-            let mut cov = [[0.0; 3]; 3];
-            for s in spokes.offsets[i]..spokes.offsets[i + 1] {
-                let xj = current[spokes.neighbors[s] as usize];
-                let w = spokes.weights[s];
-                let d = [w * (xi[0] - xj[0]), w * (xi[1] - xj[1]), w * (xi[2] - xj[2])];
-                let e = spokes.rest_edges[s];
-                for a in 0..3 {
-                    for b in 0..3 {
-                        cov[a][b] += d[a] * e[b];
+    fn local_step(spokes: &Spokes, current: &[[f64; 3]], rotations: &mut [Mat3], frames: &mut [Mat3]) {
+        rotations.par_iter_mut().zip(frames.par_iter_mut()).enumerate().with_min_len(256).for_each(
+            |(i, (r, frame))| {
+                let xi = current[i];
+                let mut cov = [[0.0; 3]; 3];
+                for s in spokes.offsets[i]..spokes.offsets[i + 1] {
+                    let xj = current[spokes.neighbors[s] as usize];
+                    let w = spokes.weights[s];
+                    let d = [w * (xi[0] - xj[0]), w * (xi[1] - xj[1]), w * (xi[2] - xj[2])];
+                    let e = spokes.rest_edges[s];
+                    for a in 0..3 {
+                        for b in 0..3 {
+                            cov[a][b] += d[a] * e[b];
+                        }
                     }
                 }
-            }
-            *r = closest_rotation(&cov);
-        });
+                *r = closest_rotation_warm(&cov, frame);
+            },
+        );
     }
 
     /// Global-step right-hand side, `#V x 3`: constrained rows hold their targets; free rows hold
@@ -203,6 +208,7 @@ impl DeformationMethod for Arap {
         self.bbox_diagonal = rest.bbox_diagonal();
         self.current = self.rest.clone();
         self.rotations = vec![[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]; n];
+        self.singular_frames = self.rotations.clone();
         self.rhs_rows = vec![[0.0; 3]; n];
         self.rhs = Mat::zeros(n, 3);
         self.handles = None;
@@ -253,7 +259,7 @@ impl DeformationMethod for Arap {
         let mut summary = SolveSummary { iterations: 0, converged: false, final_step: f64::INFINITY };
         for iteration in 0..self.params.max_iterations {
             let start = Instant::now();
-            Self::local_step(spokes, &self.current, &mut self.rotations);
+            Self::local_step(spokes, &self.current, &mut self.rotations, &mut self.singular_frames);
             Self::assemble_rhs(
                 spokes,
                 &self.rotations,
