@@ -136,6 +136,7 @@ pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
 }
 
 /// The workspace root (configs/ and reports/ live there), from the harness crate's location.
-pub fn workspace_root() -> &'static Path {
-    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
+pub fn workspace_root() -> PathBuf {
+    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
+    root.canonicalize().unwrap_or_else(|_| root.to_path_buf())
 }

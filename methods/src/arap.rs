@@ -43,7 +43,7 @@ pub struct ArapParams {
 
 impl Default for ArapParams {
     fn default() -> Self {
-        Self { max_iterations: 100, tolerance: 1e-5 }
+        Self { max_iterations: 1000, tolerance: 1e-5 }
     }
 }
 
