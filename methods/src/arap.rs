@@ -15,7 +15,6 @@
 //! by identity (same pattern, so the symbolic analysis is reused for any handle set); each iteration is
 //! one local step, one right-hand side assembly and one back-substitution of 3 columns.
 
-use std::ops::ControlFlow;
 use std::time::Instant;
 
 use faer::sparse::SparseColMat;
@@ -26,7 +25,7 @@ use serde::Deserialize;
 
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets, FREE};
-use crate::method::{check_finite, DeformationMethod, IterationObserver, IterationReport, SolveSummary};
+use crate::method::{finish_iteration, DeformationMethod, IterationObserver, SolveSummary};
 use crate::operators::cotan_laplacian;
 use crate::rotation_fit::{closest_rotation_warm, Mat3};
 use crate::sparse_cholesky::SparseCholesky;
@@ -269,26 +268,18 @@ impl DeformationMethod for Arap {
                 &mut self.rhs,
             );
             cholesky.solve_in_place(self.rhs.as_mut());
-            let mut step2: f64 = 0.0;
-            for (i, x) in self.current.iter_mut().enumerate() {
-                let new = [self.rhs[(i, 0)], self.rhs[(i, 1)], self.rhs[(i, 2)]];
-                let d = meshes::vector::sub(new, *x);
-                step2 = step2.max(meshes::vector::dot(d, d));
-                *x = new;
-            }
-            if let Err(vertex) = check_finite(&self.current) {
-                return Err(MethodError::NonFinite { method: "arap", vertex, iteration });
-            }
-            let step = step2.sqrt() / self.bbox_diagonal;
-            let report = IterationReport { iteration, step, seconds: start.elapsed().as_secs_f64() };
-            summary = SolveSummary {
-                iterations: iteration + 1,
-                converged: step < self.params.tolerance,
-                final_step: step,
-            };
-            let current = &self.current;
-            let flow = observer.on_iteration(&report, &|| current.clone());
-            if summary.converged || flow == ControlFlow::Break(()) {
+            let (done, stop) = finish_iteration(
+                "arap",
+                iteration,
+                start,
+                &mut self.current,
+                self.rhs.as_ref(),
+                self.bbox_diagonal,
+                self.params.tolerance,
+                observer,
+            )?;
+            summary = done;
+            if stop {
                 break;
             }
         }

@@ -21,7 +21,6 @@
 //!   `omega^2 Phi^T Phi` (a diagonal, so the pattern and the symbolic factorization are reused) and
 //!   factors numerically.
 
-use std::ops::ControlFlow;
 use std::time::Instant;
 
 use faer::sparse::linalg::matmul::{sparse_dense_matmul, sparse_sparse_matmul};
@@ -33,7 +32,7 @@ use serde::Deserialize;
 
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
-use crate::method::{check_finite, DeformationMethod, IterationObserver, IterationReport, SolveSummary};
+use crate::method::{finish_iteration, DeformationMethod, IterationObserver, SolveSummary};
 use crate::operators::cotan_laplacian;
 use crate::sparse_cholesky::{add_to_diagonal, SparseCholesky};
 
@@ -235,26 +234,18 @@ impl DeformationMethod for LaplacianEditing {
                 }
             }
             self.cholesky.as_mut().expect("bound").solve_in_place(self.rhs.as_mut());
-            let mut step2: f64 = 0.0;
-            for (i, x) in self.current.iter_mut().enumerate() {
-                let new = [self.rhs[(i, 0)], self.rhs[(i, 1)], self.rhs[(i, 2)]];
-                let d = sub(new, *x);
-                step2 = step2.max(dot(d, d));
-                *x = new;
-            }
-            if let Err(vertex) = check_finite(&self.current) {
-                return Err(MethodError::NonFinite { method: "laplacian", vertex, iteration });
-            }
-            let step = step2.sqrt() / rest.bbox_diagonal;
-            let report = IterationReport { iteration, step, seconds: start.elapsed().as_secs_f64() };
-            summary = SolveSummary {
-                iterations: iteration + 1,
-                converged: step < self.params.tolerance,
-                final_step: step,
-            };
-            let current = &self.current;
-            let flow = observer.on_iteration(&report, &|| current.clone());
-            if summary.converged || flow == ControlFlow::Break(()) {
+            let (done, stop) = finish_iteration(
+                "laplacian",
+                iteration,
+                start,
+                &mut self.current,
+                self.rhs.as_ref(),
+                rest.bbox_diagonal,
+                self.params.tolerance,
+                observer,
+            )?;
+            summary = done;
+            if stop {
                 break;
             }
         }

@@ -87,10 +87,35 @@ pub fn max_displacement(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     a.iter().zip(b).map(|(p, q)| meshes::vector::norm(meshes::vector::sub(*p, *q))).fold(0.0, f64::max)
 }
 
-/// First non-finite position as `Err(vertex)`.
-pub(crate) fn check_finite(positions: &[[f64; 3]]) -> Result<(), usize> {
-    match positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-        Some(v) => Err(v),
-        None => Ok(()),
+/// The end of one iteration of a full-space method: move `current` (`#V x 3`) to the new iterate
+/// `solution` (`#V x 3`, column per coordinate), check it, report the step (relative to `diagonal`)
+/// and the time since `start` to `observer`. Returns the summary so far and whether to stop
+/// (converged below `tolerance`, or the observer asked).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn finish_iteration(
+    method: &'static str,
+    iteration: usize,
+    start: std::time::Instant,
+    current: &mut [[f64; 3]],
+    solution: faer::MatRef<'_, f64>,
+    diagonal: f64,
+    tolerance: f64,
+    observer: &mut dyn IterationObserver,
+) -> Result<(SolveSummary, bool), crate::MethodError> {
+    let mut step2: f64 = 0.0;
+    for (i, x) in current.iter_mut().enumerate() {
+        let new = [solution[(i, 0)], solution[(i, 1)], solution[(i, 2)]];
+        if new.iter().any(|c| !c.is_finite()) {
+            return Err(crate::MethodError::NonFinite { method, vertex: i, iteration });
+        }
+        let d = meshes::vector::sub(new, *x);
+        step2 = step2.max(meshes::vector::dot(d, d));
+        *x = new;
     }
+    let step = step2.sqrt() / diagonal;
+    let report = IterationReport { iteration, step, seconds: start.elapsed().as_secs_f64() };
+    let summary = SolveSummary { iterations: iteration + 1, converged: step < tolerance, final_step: step };
+    let current: &[[f64; 3]] = current;
+    let flow = observer.on_iteration(&report, &|| current.to_vec());
+    Ok((summary, summary.converged || flow == ControlFlow::Break(())))
 }

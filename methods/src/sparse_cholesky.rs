@@ -144,3 +144,67 @@ pub fn add_to_diagonal(a: &SparseColMat<usize, f64>, d: &[f64]) -> SparseColMat<
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::sparse::Triplet;
+
+    /// 1D Laplacian plus `shift` on the diagonal: tridiagonal, SPD for `shift > 0`.
+    fn tridiagonal(n: usize, shift: f64) -> SparseColMat<usize, f64> {
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.push(Triplet::new(i, i, 2.0 + shift));
+            if i + 1 < n {
+                t.push(Triplet::new(i, i + 1, -1.0));
+                t.push(Triplet::new(i + 1, i, -1.0));
+            }
+        }
+        SparseColMat::try_new_from_triplets(n, n, &t).unwrap()
+    }
+
+    fn residual(a: &SparseColMat<usize, f64>, x: &faer::Mat<f64>, b: &faer::Mat<f64>) -> f64 {
+        let ax = a * x;
+        (0..b.nrows())
+            .flat_map(|i| (0..b.ncols()).map(move |j| (i, j)))
+            .map(|(i, j)| (ax[(i, j)] - b[(i, j)]).abs())
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn symbolic_analysis_is_reused_across_numeric_factorizations() {
+        let n = 200;
+        let b = faer::Mat::from_fn(n, 3, |i, j| ((i * 7 + j * 3) % 11) as f64 - 5.0);
+        let mut chol = SparseCholesky::analyze(tridiagonal(n, 0.1).as_ref()).unwrap();
+        for shift in [0.1, 1.0, 10.0] {
+            let a = tridiagonal(n, shift);
+            chol.factorize(a.as_ref()).unwrap();
+            let mut x = b.clone();
+            chol.solve_in_place(x.as_mut());
+            assert!(residual(&a, &x, &b) < 1e-10, "shift {shift}");
+        }
+    }
+
+    #[test]
+    fn other_pattern_and_indefinite_matrices_are_errors() {
+        let mut chol = SparseCholesky::analyze(tridiagonal(10, 1.0).as_ref()).unwrap();
+        assert!(matches!(chol.factorize(tridiagonal(11, 1.0).as_ref()), Err(SolverError::PatternMismatch)));
+        assert!(matches!(
+            chol.factorize(tridiagonal(10, -3.0).as_ref()),
+            Err(SolverError::NotPositiveDefinite)
+        ));
+        let mut nan = tridiagonal(10, 1.0);
+        nan.val_mut()[0] = f64::NAN;
+        assert!(matches!(chol.factorize(nan.as_ref()), Err(SolverError::NotPositiveDefinite)));
+    }
+
+    #[test]
+    fn adding_to_the_diagonal_keeps_the_pattern() {
+        let a = tridiagonal(5, 0.0);
+        let b = add_to_diagonal(&a, &[1.0, 0.0, 2.0, 0.0, 3.0]);
+        assert_eq!(a.symbolic().row_idx(), b.symbolic().row_idx());
+        assert_eq!(b[(0, 0)], 3.0);
+        assert_eq!(b[(2, 2)], 4.0);
+        assert_eq!(b[(1, 1)], 2.0);
+    }
+}
