@@ -200,7 +200,7 @@ impl DeformationMethod for LaplacianEditing {
         for v in handles.constrained() {
             diagonal[v as usize] = w2;
         }
-        cholesky.factorize(add_to_diagonal(&rest.normal_matrix, &diagonal).as_ref())?;
+        cholesky.factorize(add_to_diagonal(rest.normal_matrix.as_ref(), &diagonal).as_ref())?;
         self.handles = Some(handles.clone());
         Ok(())
     }

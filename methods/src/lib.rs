@@ -10,6 +10,7 @@ pub mod operators;
 pub mod registry;
 pub mod rotation_fit;
 pub mod sparse_cholesky;
+pub mod spectral;
 
 pub use error::MethodError;
 pub use handles::{HandleRegion, HandleSet, HandleTargets};

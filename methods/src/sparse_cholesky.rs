@@ -133,16 +133,23 @@ impl SparseCholesky {
 
 /// `A + diag(d)` for a matrix `A` whose pattern contains the diagonal; the pattern is unchanged, so a
 /// symbolic factorization of `A` can be reused.
-pub fn add_to_diagonal(a: &SparseColMat<usize, f64>, d: &[f64]) -> SparseColMat<usize, f64> {
-    let mut out = a.clone();
-    let (symbolic, values) = out.parts_mut();
+pub fn add_to_diagonal(a: SparseColMatRef<'_, usize, f64>, d: &[f64]) -> SparseColMat<usize, f64> {
+    let symbolic = a.symbolic();
+    let mut values = a.val().to_vec();
     for j in 0..symbolic.ncols() {
         let range = symbolic.col_range(j);
         let rows = &symbolic.row_idx()[range.clone()];
         let pos = rows.binary_search(&j).expect("pattern contains the diagonal");
         values[range.start + pos] += d[j];
     }
-    out
+    let pattern = faer::sparse::SymbolicSparseColMat::new_checked(
+        symbolic.nrows(),
+        symbolic.ncols(),
+        symbolic.col_ptr().to_vec(),
+        None,
+        symbolic.row_idx().to_vec(),
+    );
+    SparseColMat::new(pattern, values)
 }
 
 #[cfg(test)]
@@ -201,7 +208,7 @@ mod tests {
     #[test]
     fn adding_to_the_diagonal_keeps_the_pattern() {
         let a = tridiagonal(5, 0.0);
-        let b = add_to_diagonal(&a, &[1.0, 0.0, 2.0, 0.0, 3.0]);
+        let b = add_to_diagonal(a.as_ref(), &[1.0, 0.0, 2.0, 0.0, 3.0]);
         assert_eq!(a.symbolic().row_idx(), b.symbolic().row_idx());
         assert_eq!(b[(0, 0)], 3.0);
         assert_eq!(b[(2, 2)], 4.0);

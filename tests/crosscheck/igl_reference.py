@@ -33,9 +33,9 @@ harmonic MESH CONSTRAINTS OUT
     CONSTRAINTS: one line per boundary vertex, `index value`. igl.harmonic with k=1.
     OUT: one value per vertex.
 
-eigs MESH K OUT
+eigs MESH K OUT [--mass barycentric|voronoi]
     Generalized eigenproblem  (-L) x = lambda M x  with L = igl.cotmatrix, M = igl.massmatrix
-    (VORONOI), solved by scipy.sparse.linalg.eigsh in shift-invert mode (sigma slightly negative,
+    (BARYCENTRIC by default, Rong et al. 2008 eq 6; or VORONOI), solved by scipy.sparse.linalg.eigsh in shift-invert mode (sigma slightly negative,
     which='LM', k=K). Eigenvalues ascending, one per line, to OUT; eigenvectors (M-orthonormal,
     columns matching the eigenvalues) to OUT + '.vectors', n lines of K values each.
     Prints {"seconds": <eigsh wall time>} on stdout.
@@ -299,10 +299,12 @@ def cmd_eigs(args):
     if args.k >= n:
         raise UsageError(f"K={args.k} must be smaller than the vertex count {n}")
     L = igl.cotmatrix(V, F).tocsc()
-    M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).tocsc()
+    mass_type = {"voronoi": igl.MASSMATRIX_TYPE_VORONOI, "barycentric": igl.MASSMATRIX_TYPE_BARYCENTRIC}[args.mass]
+    M = igl.massmatrix(V, F, mass_type).tocsc()
     A = (-L).tocsc()
-    # Deterministic start vector so reruns give the same (sign of the) eigenvectors.
-    v0 = np.ones(n) / np.sqrt(n)
+    # Deterministic start vector so reruns give the same (sign of the) eigenvectors. Not the constant
+    # vector: that is an eigenvector, and a Krylov method started from it breaks down at once.
+    v0 = np.random.default_rng(12345).uniform(-1.0, 1.0, n)
     t0 = time.perf_counter()
     vals, vecs = spla.eigsh(A, k=args.k, M=M, sigma=-1e-8, which="LM", v0=v0)
     seconds = time.perf_counter() - t0
@@ -377,10 +379,11 @@ def build_parser():
     s.add_argument("out")
     s.set_defaults(func=cmd_harmonic)
 
-    s = sub.add_parser("eigs", help="smallest generalized eigenpairs of (-L, M_voronoi)")
+    s = sub.add_parser("eigs", help="smallest generalized eigenpairs of (-L, M)")
     s.add_argument("mesh")
     s.add_argument("k", type=positive_int)
     s.add_argument("out")
+    s.add_argument("--mass", choices=["barycentric", "voronoi"], default="barycentric")
     s.set_defaults(func=cmd_eigs)
 
     s = sub.add_parser("constraints", help="ARAP constraints file from a .sel/.def pair")
