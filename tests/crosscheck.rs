@@ -109,3 +109,78 @@ fn arap_matches_libigl_arap_solve() {
         }
     }
 }
+
+/// Largest sine of the principal angles between span(ours) and span(reference), both D-orthonormal
+/// (`#V` rows), in the D inner product.
+fn largest_angle_sine(ours: &faer::Mat<f64>, reference: &faer::Mat<f64>, mass: &[f64]) -> f64 {
+    let n = ours.nrows();
+    let d_ref = faer::Mat::from_fn(n, reference.ncols(), |i, j| mass[i] * reference[(i, j)]);
+    let residual = ours - reference * (d_ref.transpose() * ours);
+    let d_res = faer::Mat::from_fn(n, residual.ncols(), |i, j| mass[i] * residual[(i, j)]);
+    let gram = residual.transpose() * &d_res;
+    let top = gram.self_adjoint_eigenvalues(faer::Side::Lower).unwrap();
+    top.last().copied().unwrap_or(0.0).max(0.0).sqrt()
+}
+
+#[test]
+fn manifold_harmonics_match_scipy_eigsh() {
+    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    // scipy computes a few more pairs so that a cluster cut at k is still compared with its full span.
+    const EXTRA: usize = 8;
+    for name in MESHES {
+        let mesh_path = dir.join(format!("{name}.off"));
+        let mesh = meshes::io::read_mesh(&mesh_path).unwrap();
+        let mut stiffness = cotan_laplacian(mesh.positions(), mesh.triangles());
+        stiffness.val_mut().iter_mut().for_each(|v| *v = -*v);
+        let mass = lumped_mass(mesh.positions(), mesh.triangles(), MassKind::Barycentric);
+        for k in [20usize, 100] {
+            let work = tempfile::tempdir().unwrap();
+            let out = work.path().join("eigs.txt");
+            igl_reference(
+                &py,
+                &[
+                    "eigs",
+                    mesh_path.to_str().unwrap(),
+                    &(k + EXTRA).to_string(),
+                    out.to_str().unwrap(),
+                    "--mass",
+                    "barycentric",
+                ],
+            );
+            let values: Vec<f64> = read_rows(&out).into_iter().map(|r| r[0]).collect();
+            let rows = read_rows(&out.with_extension("txt.vectors"));
+            let reference = faer::Mat::from_fn(rows.len(), k + EXTRA, |i, j| rows[i][j]);
+            let ours = methods::spectral::smallest_eigenpairs(
+                stiffness.as_ref(),
+                &mass,
+                &methods::spectral::EigenOptions::new(k),
+            )
+            .unwrap();
+            assert_eq!(ours.constant_mode, Some(0), "{name}: constant mode not flagged");
+            let scale = values[k - 1];
+            let worst_value = (0..k)
+                .map(|i| (ours.values[i] - values[i]).abs() / values[i].abs().max(1e-3 * scale))
+                .fold(0.0, f64::max);
+            // Clusters: eigenvalues closer than 1e-4 of the scale have ill-determined single vectors.
+            let mut worst_angle = 0.0f64;
+            let mut start = 0;
+            for i in 1..=k {
+                if i < k && (ours.values[i] - ours.values[i - 1]).abs() <= 1e-4 * scale {
+                    continue;
+                }
+                let (lo, hi) = (ours.values[start] - 1e-4 * scale, ours.values[i - 1] + 1e-4 * scale);
+                let span: Vec<usize> =
+                    (0..k + EXTRA).filter(|&j| values[j] >= lo && values[j] <= hi).collect();
+                let a = faer::Mat::from_fn(mass.len(), i - start, |r, c| ours.vectors[(r, start + c)]);
+                let b = faer::Mat::from_fn(mass.len(), span.len(), |r, c| reference[(r, span[c])]);
+                worst_angle = worst_angle.max(largest_angle_sine(&a, &b, &mass).asin());
+                start = i;
+            }
+            println!(
+                "{name}, k = {k}: eigenvalues max relative difference {worst_value:.2e}, largest principal angle {worst_angle:.2e}"
+            );
+            assert!(worst_value <= 1e-8, "{name}, k = {k}: eigenvalues differ from scipy by {worst_value:e}");
+            assert!(worst_angle < 1e-6, "{name}, k = {k}: principal angle {worst_angle:e}");
+        }
+    }
+}

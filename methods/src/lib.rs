@@ -11,6 +11,7 @@ pub mod registry;
 pub mod rotation_fit;
 pub mod sparse_cholesky;
 pub mod spectral;
+pub mod spectral_mhb;
 
 pub use error::MethodError;
 pub use handles::{HandleRegion, HandleSet, HandleTargets};

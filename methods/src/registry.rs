@@ -6,6 +6,7 @@ use crate::arap::Arap;
 use crate::error::MethodError;
 use crate::laplacian::LaplacianEditing;
 use crate::method::DeformationMethod;
+use crate::spectral_mhb::SpectralMhb;
 
 /// One registered method.
 pub struct MethodEntry {
@@ -28,6 +29,11 @@ pub const METHODS: &[MethodEntry] = &[
         name: "arap",
         summary: "As-Rigid-As-Possible surface modeling (Sorkine & Alexa 2007), cotangent weights, hard constraints",
         create: |p| Ok(Box::new(Arap::new(parse("arap", p)?)?)),
+    },
+    MethodEntry {
+        name: "spectral_mhb",
+        summary: "spectral mesh deformation in manifold harmonics bases with deformation transfer of details (Rong, Cao & Guo 2008)",
+        create: |p| Ok(Box::new(SpectralMhb::new(parse("spectral_mhb", p)?)?)),
     },
 ];
 
