@@ -43,7 +43,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
     assert_eq!(code, std::process::ExitCode::SUCCESS);
     let rows = csv_rows(&reports.path().join("results.csv"));
     for scenario in ["bar", "cactus", "cylinder", "plane"] {
-        for method in ["laplacian", "arap"] {
+        for method in methods::registry::method_names() {
             let row = rows
                 .iter()
                 .find(|r| r["scenario"] == scenario && r["method"] == method)
@@ -51,7 +51,12 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
             assert_eq!(row["status"], "ok", "{scenario}/{method}");
             assert_eq!(row["mesh_source"], "survey");
             let residual = num(row, "handle_residual_over_diag");
-            let bound = if method == "arap" { 1e-9 } else { 1e-3 };
+            // The bounds for the references; the reduced models only approximate their handles.
+            let bound = match method {
+                "arap" => 1e-9,
+                "laplacian" => 1e-3,
+                _ => 5e-2,
+            };
             assert!(residual <= bound, "{scenario}/{method}: handle residual {residual:e} > {bound:e}");
             for key in [
                 "e_theta_deg",
@@ -110,7 +115,7 @@ fn without_survey_data_the_procedural_look_alikes_run_and_are_labelled() {
     .unwrap();
     assert_eq!(code, std::process::ExitCode::SUCCESS);
     let rows = csv_rows(&reports.path().join("results.csv"));
-    assert_eq!(rows.len(), 8);
+    assert_eq!(rows.len(), 4 * methods::registry::METHODS.len());
     for row in &rows {
         assert_eq!(row["mesh_source"], "procedural look-alike");
         assert_eq!(row["status"], "ok", "{}/{}", row["scenario"], row["method"]);

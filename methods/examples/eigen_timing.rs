@@ -1,4 +1,5 @@
-//! Time `spectral::smallest_eigenpairs` on a mesh: `eigen_timing MESH K [MASS]`, MASS `barycentric`
+//! Time `spectral::smallest_eigenpairs` on a mesh: `eigen_timing MESH K [MASS]` (MESH a file or
+//! `procedural:SHAPE:VERTICES`), MASS `barycentric`
 //! (default, Rong et al. eq 6) or `voronoi`. Prints one JSON line; `scripts/bench-eigs-vs-scipy` runs
 //! it next to scipy's eigsh.
 
@@ -17,7 +18,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some("voronoi") => MassKind::Voronoi,
         Some(other) => return Err(format!("unknown mass kind {other}").into()),
     };
-    let mesh = meshes::io::read_mesh(mesh_path)?;
+    // `procedural:SHAPE:VERTICES` generates a look-alike instead of reading a file.
+    let mesh = match mesh_path.strip_prefix("procedural:").and_then(|s| s.split_once(':')) {
+        Some((shape, vertices)) => meshes::shapes::generate(shape.parse()?, vertices.parse()?)?.mesh,
+        None => meshes::io::read_mesh(mesh_path)?,
+    };
     let k: usize = k.parse()?;
     let mut stiffness = cotan_laplacian(mesh.positions(), mesh.triangles());
     stiffness.val_mut().iter_mut().for_each(|v| *v = -*v);
