@@ -1,11 +1,26 @@
 //! A thin layer over faer's sparse Cholesky: symbolic analysis once per sparsity pattern, numeric
 //! factorization whenever the values change, back-substitution with preallocated workspace.
+//!
+//! The back-substitution does not go through faer: after each numeric factorization the factor is
+//! copied into a supernodal layout (`blocked::BlockedFactor`) with row-major blocks, and the
+//! right-hand sides are solved in a permuted row-major workspace (see that module). For several
+//! right-hand-side columns this is several times faster than faer's column-major supernodal solve.
 
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+mod blocked;
+
+use blocked::BlockedFactor;
+use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky};
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, SymbolicCholesky};
 use faer::sparse::{SparseColMat, SparseColMatRef};
-use faer::{Conj, MatMut, Par, Side};
+use faer::{MatMut, MatRef, Par, Side};
+
+/// Right-hand-side columns solved together; wider blocks are split into chunks of this many.
+const CHUNK: usize = 16;
+
+/// From this many right-hand-side columns on, two column halves are solved on two threads.
+const PARALLEL_MIN_COLS: usize = 16;
 
 /// Failures of the sparse solver layer.
 #[derive(Debug, thiserror::Error)]
@@ -31,8 +46,14 @@ pub struct SparseCholesky {
     row_idx: Vec<usize>,
     values: Vec<f64>,
     factorized: bool,
-    workspace: MemBuffer,
-    workspace_cols: usize,
+    /// The factor re-laid out for the triangular solves.
+    blocked: BlockedFactor,
+    /// Row-major permuted right-hand sides, `n x padded_width(min(k, CHUNK))`.
+    workspace: Vec<f64>,
+    /// The same for the second thread of a parallel solve.
+    workspace_parallel: Vec<f64>,
+    /// Inverse of the fill-reducing permutation (identity without one).
+    perm_inv: Vec<usize>,
     par: Par,
 }
 
@@ -51,14 +72,20 @@ impl SparseCholesky {
         .map_err(|e| SolverError::Faer(format!("{e:?}")))?;
         let values = vec![0.0; symbolic.len_val()];
         let par = Par::Seq;
+        let perm_inv = match symbolic.perm() {
+            Some(perm) => perm.arrays().1.to_vec(),
+            None => (0..symbolic.nrows()).collect(),
+        };
         Ok(Self {
             col_ptr: matrix.symbolic().col_ptr().to_vec(),
             row_idx: matrix.symbolic().row_idx().to_vec(),
+            blocked: BlockedFactor::new(symbolic.raw()),
             symbolic,
             values,
             factorized: false,
-            workspace: MemBuffer::new(StackReq::EMPTY),
-            workspace_cols: 0,
+            workspace: Vec::new(),
+            workspace_parallel: Vec::new(),
+            perm_inv,
             par,
         })
     }
@@ -99,12 +126,18 @@ impl SparseCholesky {
                 Default::default(),
             )
             .map_err(|_| SolverError::NotPositiveDefinite)?;
+        self.blocked.set_values(&self.values);
         self.factorized = true;
         Ok(())
     }
 
     /// Solve `A X = B` in place for the `n x k` right-hand sides `rhs`. Workspace is allocated on the
-    /// first call for `k` columns and reused afterwards.
+    /// first call for `k` columns (an `n x 16` block at most) and reused afterwards.
+    ///
+    /// Columns are solved together in chunks of up to 16, so several columns cost much less than
+    /// as many single solves. From 16 columns on, two halves of the columns are solved on two rayon
+    /// threads. The result for given inputs is bitwise reproducible (it depends on `k`, not on
+    /// thread scheduling).
     ///
     /// # Panics
     /// If called before a successful [`SparseCholesky::factorize`] or with the wrong number of rows
@@ -112,22 +145,117 @@ impl SparseCholesky {
     pub fn solve_in_place(&mut self, rhs: MatMut<'_, f64>) {
         assert!(self.factorized, "solve before factorize");
         assert_eq!(rhs.nrows(), self.dim());
+        let n = self.dim();
         let k = rhs.ncols();
-        if k > self.workspace_cols {
-            self.workspace = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(k, self.par));
-            self.workspace_cols = k;
+        if n == 0 || k == 0 {
+            return;
         }
-        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
-            Conj::No,
-            rhs,
-            self.par,
-            MemStack::new(&mut self.workspace),
-        );
+        if k >= PARALLEL_MIN_COLS && rayon::current_num_threads() > 1 {
+            // Two independent column halves on two threads, each with its own workspace.
+            let (left, right) = rhs.split_at_col_mut(k.div_ceil(2));
+            let (blocked, perm_inv) = (&self.blocked, self.perm_inv.as_slice());
+            let (ws_left, ws_right) = (&mut self.workspace, &mut self.workspace_parallel);
+            rayon::join(
+                || solve_columns(blocked, perm_inv, ws_left, left),
+                || solve_columns(blocked, perm_inv, ws_right, right),
+            );
+        } else {
+            solve_columns(&self.blocked, &self.perm_inv, &mut self.workspace, rhs);
+        }
     }
 
     /// Number of stored entries of the factor (fill-in indicator).
     pub fn factor_nnz(&self) -> usize {
         self.values.len()
+    }
+}
+
+/// Solve in place for the columns of `rhs`, in chunks of at most [`CHUNK`] columns, each padded
+/// to a supported block width in the row-major `workspace` (grown on demand).
+fn solve_columns(
+    blocked: &BlockedFactor,
+    perm_inv: &[usize],
+    workspace: &mut Vec<f64>,
+    mut rhs: MatMut<'_, f64>,
+) {
+    let n = rhs.nrows();
+    let k = rhs.ncols();
+    let width = blocked::padded_width(k.min(CHUNK));
+    if workspace.len() < n * width {
+        workspace.resize(n * width, 0.0);
+    }
+    for c in (0..k).step_by(CHUNK) {
+        let kc = CHUNK.min(k - c);
+        let width = blocked::padded_width(kc);
+        let x = &mut workspace[..n * width];
+        let mut block = rhs.rb_mut().subcols_mut(c, kc);
+        macro_rules! run {
+            ($w:literal) => {{
+                load_permuted::<$w>(block.rb(), perm_inv, x);
+                blocked.solve_row_major(x, $w);
+                store_permuted::<$w>(x, perm_inv, block.rb_mut());
+            }};
+        }
+        match width {
+            1 => run!(1),
+            2 => run!(2),
+            4 => run!(4),
+            8 => run!(8),
+            16 => run!(16),
+            _ => unreachable!("padded widths are powers of two up to CHUNK"),
+        }
+    }
+}
+
+/// Row `inv[p]` of the row-major `n x W` block `x` is row `p` of `b` (`b.ncols() <= W`), padded with
+/// zeros: `x = P b` for the fill-reducing permutation `P` with inverse `inv`.
+fn load_permuted<const W: usize>(b: MatRef<'_, f64>, inv: &[usize], x: &mut [f64]) {
+    let k = b.ncols();
+    let mut cols: [&[f64]; W] = [&[]; W];
+    let contiguous = b.col_iter().zip(&mut cols).all(|(col, slot)| match col.try_as_col_major() {
+        Some(col) => {
+            *slot = col.as_slice();
+            true
+        }
+        None => false,
+    });
+    if contiguous {
+        for (p, &i) in inv.iter().enumerate() {
+            let row: &mut [f64; W] = (&mut x[i * W..i * W + W]).try_into().unwrap();
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = if j < k { cols[j][p] } else { 0.0 };
+            }
+        }
+    } else {
+        for (p, &i) in inv.iter().enumerate() {
+            let row: &mut [f64; W] = (&mut x[i * W..i * W + W]).try_into().unwrap();
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = if j < k { b[(p, j)] } else { 0.0 };
+            }
+        }
+    }
+}
+
+/// Row `p` of `b` is row `inv[p]` of `x` (the inverse of [`load_permuted`]).
+fn store_permuted<const W: usize>(x: &[f64], inv: &[usize], mut b: MatMut<'_, f64>) {
+    let k = b.ncols();
+    if b.row_stride() == 1 {
+        let mut cols: [&mut [f64]; W] = std::array::from_fn(|_| &mut [][..]);
+        for (col, slot) in b.col_iter_mut().zip(&mut cols) {
+            *slot = col.try_as_col_major_mut().expect("unit row stride").as_slice_mut();
+        }
+        for (p, &i) in inv.iter().enumerate() {
+            let row: &[f64; W] = x[i * W..i * W + W].try_into().unwrap();
+            for (col, &v) in cols[..k].iter_mut().zip(row) {
+                col[p] = v;
+            }
+        }
+    } else {
+        for (p, &i) in inv.iter().enumerate() {
+            for j in 0..k {
+                b[(p, j)] = x[i * W + j];
+            }
+        }
     }
 }
 
@@ -167,6 +295,29 @@ mod tests {
                 t.push(Triplet::new(i + 1, i, -1.0));
             }
         }
+        SparseColMat::try_new_from_triplets(n, n, &t).unwrap()
+    }
+
+    /// Weighted graph Laplacian of an `m^dim` grid (nearest neighbours; weights vary irregularly in
+    /// [1, 1.9]) plus `shift` on the diagonal: SPD for `shift > 0`.
+    fn grid(m: usize, dim: u32, shift: f64) -> SparseColMat<usize, f64> {
+        let n = m.pow(dim);
+        let mut t = Vec::new();
+        let mut diag = vec![shift; n];
+        for a in 0..n {
+            for axis in 0..dim {
+                let stride = m.pow(axis);
+                if (a / stride) % m + 1 < m {
+                    let b = a + stride;
+                    let w = 1.0 + ((a * 7919 + b * 104729) % 10) as f64 / 10.0;
+                    t.push(Triplet::new(a, b, -w));
+                    t.push(Triplet::new(b, a, -w));
+                    diag[a] += w;
+                    diag[b] += w;
+                }
+            }
+        }
+        t.extend(diag.iter().enumerate().map(|(i, &d)| Triplet::new(i, i, d)));
         SparseColMat::try_new_from_triplets(n, n, &t).unwrap()
     }
 
@@ -213,5 +364,102 @@ mod tests {
         assert_eq!(b[(0, 0)], 3.0);
         assert_eq!(b[(2, 2)], 4.0);
         assert_eq!(b[(1, 1)], 2.0);
+    }
+
+    /// Right-hand sides with entries in [-1, 1), different in every column.
+    fn rhs(n: usize, k: usize) -> faer::Mat<f64> {
+        faer::Mat::from_fn(n, k, |i, j| ((i * 7919 + j * 104729 + i * j) % 1000) as f64 / 500.0 - 1.0)
+    }
+
+    /// faer's own supernodal/simplicial solve with the same factor.
+    fn faer_solve(chol: &SparseCholesky, b: &faer::Mat<f64>) -> faer::Mat<f64> {
+        use faer::sparse::linalg::cholesky::LltRef;
+        let mut x = b.clone();
+        let mut stack = MemBuffer::new(chol.symbolic.solve_in_place_scratch::<f64>(b.ncols(), Par::Seq));
+        LltRef::new(&chol.symbolic, &chol.values).solve_in_place_with_conj(
+            faer::Conj::No,
+            x.as_mut(),
+            Par::Seq,
+            MemStack::new(&mut stack),
+        );
+        x
+    }
+
+    /// Largest over the columns of `max_i |x_ij - y_ij| / max_i |y_ij|`.
+    fn relative_difference(x: &faer::Mat<f64>, y: &faer::Mat<f64>) -> f64 {
+        (0..y.ncols())
+            .map(|j| {
+                let (x, y) = (x.col(j), y.col(j));
+                let diff = (0..y.nrows()).map(|i| (x[i] - y[i]).abs()).fold(0.0, f64::max);
+                diff / (0..y.nrows()).map(|i| y[i].abs()).fold(0.0, f64::max)
+            })
+            .fold(0.0, f64::max)
+    }
+
+    fn is_supernodal(chol: &SparseCholesky) -> bool {
+        matches!(chol.symbolic.raw(), faer::sparse::linalg::cholesky::SymbolicCholeskyRaw::Supernodal(_))
+    }
+
+    /// Our solve against faer's for several widths, including chunked and two-thread ones, with
+    /// the kernels this CPU uses and with the portable ones.
+    fn check_against_faer(a: &SparseColMat<usize, f64>) {
+        for portable in [false, true] {
+            let mut chol = SparseCholesky::new(a.as_ref()).unwrap();
+            if portable {
+                chol.blocked.disable_fma();
+            }
+            for k in [1, 2, 3, 4, 5, 8, 13, 16, 17, 32] {
+                let b = rhs(a.nrows(), k);
+                let mut x = b.clone();
+                chol.solve_in_place(x.as_mut());
+                let diff = relative_difference(&x, &faer_solve(&chol, &b));
+                assert!(diff <= 1e-12, "k = {k}: relative difference {diff:e}");
+                assert!(residual(a, &x, &b) < 1e-8, "k = {k}");
+            }
+        }
+    }
+
+    #[test]
+    fn supernodal_factors_solve_like_faer() {
+        for a in [grid(150, 2, 0.01), grid(16, 3, 0.01)] {
+            assert!(is_supernodal(&SparseCholesky::analyze(a.as_ref()).unwrap()));
+            check_against_faer(&a);
+        }
+    }
+
+    #[test]
+    fn simplicial_factors_solve_like_faer() {
+        // Columns merged into wide fundamental supernodes, and a factor of (almost) single columns.
+        let grid = grid(100, 2, 0.01);
+        let chol = SparseCholesky::analyze(grid.as_ref()).unwrap();
+        assert!(!is_supernodal(&chol) && chol.blocked.max_supernode_width() > 16);
+        check_against_faer(&grid);
+        let tri = tridiagonal(1000, 0.01);
+        let chol = SparseCholesky::analyze(tri.as_ref()).unwrap();
+        assert!(!is_supernodal(&chol) && chol.blocked.n_supernodes() > 900);
+        check_against_faer(&tri);
+    }
+
+    #[test]
+    fn strided_right_hand_sides_and_repeated_solves_give_identical_results() {
+        let a = grid(30, 2, 0.1);
+        let n = a.nrows();
+        let mut chol = SparseCholesky::new(a.as_ref()).unwrap();
+        let b = rhs(n, 3);
+        let mut x = b.clone();
+        chol.solve_in_place(x.as_mut());
+        let mut again = b.clone();
+        chol.solve_in_place(again.as_mut());
+        assert!(x == again);
+        // Columns of a wider matrix (column stride > n) and a transposed view (row stride != 1).
+        let mut wide = faer::Mat::<f64>::zeros(n + 5, 7);
+        wide.as_mut().submatrix_mut(2, 1, n, 3).copy_from(&b);
+        chol.solve_in_place(wide.as_mut().submatrix_mut(2, 1, n, 3));
+        assert!(wide.as_ref().submatrix(2, 1, n, 3) == x.as_ref());
+        let mut transposed = b.transpose().to_owned();
+        chol.solve_in_place(transposed.as_mut().transpose_mut());
+        assert!(transposed.transpose() == x.as_ref());
+        // No columns: nothing to do.
+        chol.solve_in_place(faer::Mat::<f64>::zeros(n, 0).as_mut());
     }
 }

@@ -44,7 +44,7 @@ impl EigenOptions {
         Self {
             count,
             tolerance: 1e-11,
-            block_size: 8,
+            block_size: 4,
             basis_size: None,
             max_restarts: 300,
             seed: 0x5eed,
