@@ -38,13 +38,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let pairs = smallest_eigenpairs(stiffness.as_ref(), &mass, &options)?;
     let seconds = start.elapsed().as_secs_f64();
     println!(
-        "{{\"mesh\": \"{mesh_path}\", \"vertices\": {}, \"k\": {k}, \"seconds\": {seconds:.4}, \"restarts\": {}, \"operator_applications\": {}, \"lambda_1\": {:.6e}, \"lambda_k\": {:.6e}, \"constant_mode\": {:?}}}",
+        "{{\"mesh\": \"{mesh_path}\", \"vertices\": {}, \"k\": {k}, \"seconds\": {seconds:.4}, \"restarts\": {}, \"operator_applications\": {}, \"lambda_1\": {:.6e}, \"lambda_k\": {:.6e}, \"constant_mode\": {}}}",
         mesh.n_vertices(),
         pairs.restarts,
         pairs.operator_applications,
         pairs.values.get(1).copied().unwrap_or(f64::NAN),
         pairs.values[k - 1],
-        pairs.constant_mode
+        pairs.constant_mode.map_or("null".to_string(), |i| i.to_string())
     );
     Ok(())
 }
