@@ -218,13 +218,7 @@ impl DeformationMethod for Arap {
         let (Some(stiffness), Some(cholesky)) = (&self.stiffness, &mut self.cholesky) else {
             return Err(MethodError::Phase { method: "arap", phase: "bind_handles", missing: "precompute" });
         };
-        if handles.n_vertices() != self.rest.len() {
-            return Err(MethodError::Handles(format!(
-                "handle set is for {} vertices, the mesh has {}",
-                handles.n_vertices(),
-                self.rest.len()
-            )));
-        }
+        handles.check_mesh_size(self.rest.len())?;
         // Constrained rows and columns become identity; the pattern stays that of -L.
         let region_of = handles.region_of();
         let mut system = stiffness.clone();

@@ -64,6 +64,17 @@ impl HandleSet {
         self.n_vertices
     }
 
+    /// Fails unless this set was validated for a mesh of `n_vertices` vertices.
+    pub fn check_mesh_size(&self, n_vertices: usize) -> Result<(), MethodError> {
+        if self.n_vertices == n_vertices {
+            return Ok(());
+        }
+        Err(MethodError::Handles(format!(
+            "handle set is for {} vertices, the mesh has {n_vertices}",
+            self.n_vertices
+        )))
+    }
+
     /// `#V` region index per vertex, [`FREE`] for unconstrained vertices.
     pub fn region_of(&self) -> &[u32] {
         &self.region_of

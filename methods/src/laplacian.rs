@@ -188,13 +188,7 @@ impl DeformationMethod for LaplacianEditing {
                 missing: "precompute",
             });
         };
-        if handles.n_vertices() != self.current.len() {
-            return Err(MethodError::Handles(format!(
-                "handle set is for {} vertices, the mesh has {}",
-                handles.n_vertices(),
-                self.current.len()
-            )));
-        }
+        handles.check_mesh_size(self.current.len())?;
         let mut diagonal = vec![0.0; self.current.len()];
         let w2 = self.params.omega * self.params.omega;
         for v in handles.constrained() {

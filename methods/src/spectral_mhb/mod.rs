@@ -285,13 +285,7 @@ impl DeformationMethod for SpectralMhb {
                 missing: "precompute",
             });
         }
-        if handles.n_vertices() != self.rest.len() {
-            return Err(MethodError::Handles(format!(
-                "handle set is for {} vertices, the mesh has {}",
-                handles.n_vertices(),
-                self.rest.len()
-            )));
-        }
+        handles.check_mesh_size(self.rest.len())?;
         let start = Instant::now();
         let constrained: Vec<u32> = handles.constrained().collect();
         let m = self.basis.ncols();
