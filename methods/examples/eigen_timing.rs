@@ -27,7 +27,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut stiffness = cotan_laplacian(mesh.positions(), mesh.triangles());
     stiffness.val_mut().iter_mut().for_each(|v| *v = -*v);
     let mass = lumped_mass(mesh.positions(), mesh.triangles(), kind);
-    let start = Instant::now();
     let mut options = EigenOptions::new(k);
     if let Ok(b) = std::env::var("EIG_BLOCK") {
         options.block_size = b.parse()?;
@@ -35,8 +34,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Ok(s) = std::env::var("EIG_BASIS") {
         options.basis_size = Some(s.parse()?);
     }
-    let pairs = smallest_eigenpairs(stiffness.as_ref(), &mass, &options)?;
-    let seconds = start.elapsed().as_secs_f64();
+    // `EIG_REPEAT=N`: solve N times in this process and report the fastest (page faults and thread
+    // start-up of the first call excluded, as in a benchmark loop).
+    let repeat: usize = std::env::var("EIG_REPEAT").map_or(Ok(1), |r| r.parse())?;
+    // Start the thread pool before timing, as Python starts OpenBLAS's threads at import, before
+    // scipy's eigsh is timed.
+    rayon::broadcast(|_| ());
+    let mut seconds = f64::INFINITY;
+    let mut pairs = None;
+    for _ in 0..repeat.max(1) {
+        let start = Instant::now();
+        pairs = Some(smallest_eigenpairs(stiffness.as_ref(), &mass, &options)?);
+        seconds = seconds.min(start.elapsed().as_secs_f64());
+    }
+    let pairs = pairs.expect("at least one run");
     println!(
         "{{\"mesh\": \"{mesh_path}\", \"vertices\": {}, \"k\": {k}, \"seconds\": {seconds:.4}, \"restarts\": {}, \"operator_applications\": {}, \"lambda_1\": {:.6e}, \"lambda_k\": {:.6e}, \"constant_mode\": {}}}",
         mesh.n_vertices(),

@@ -9,6 +9,7 @@ pub mod method;
 pub mod operators;
 pub mod registry;
 pub mod rotation_fit;
+mod row_major;
 pub mod sparse_cholesky;
 pub mod spectral;
 pub mod spectral_mhb;

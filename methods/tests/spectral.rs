@@ -85,6 +85,34 @@ fn krylov_schur_matches_the_dense_solver() {
     }
 }
 
+/// A stiffness without a null vector (`Q + D`, eigenvalues shifted by 1) is solved without
+/// deflation; the deflated Laplacian's spectrum shifted by 1 must come out.
+#[test]
+fn stiffness_without_a_null_vector_is_solved_without_deflation() {
+    let (q, mass) = problem(ShapeKind::Cactus, 1500);
+    let shifted = methods::sparse_cholesky::add_to_diagonal(q.as_ref(), &mass);
+    let count = 24;
+    let laplacian = smallest_eigenpairs(q.as_ref(), &mass, &krylov(count)).unwrap();
+    let ours = smallest_eigenpairs(shifted.as_ref(), &mass, &krylov(count)).unwrap();
+    assert_eq!(ours.constant_mode, None, "lambda = 1 is not a null mode");
+    let mut dense = EigenOptions::new(count);
+    dense.dense_limit = usize::MAX;
+    compare(&ours, &smallest_eigenpairs(shifted.as_ref(), &mass, &dense).unwrap(), &mass);
+    for (a, b) in ours.values.iter().zip(&laplacian.values) {
+        assert!((a - (b + 1.0)).abs() <= 1e-9 * a, "{a} vs {b} + 1");
+    }
+}
+
+/// One eigenpair of a Laplacian is the deflated constant vector alone.
+#[test]
+fn the_constant_mode_alone_needs_no_krylov_iteration() {
+    let (q, mass) = problem(ShapeKind::Bar, 1500);
+    let pairs = smallest_eigenpairs(q.as_ref(), &mass, &krylov(1)).unwrap();
+    assert_eq!((pairs.constant_mode, pairs.operator_applications), (Some(0), 0));
+    let total: f64 = mass.iter().sum();
+    assert!((0..mass.len()).all(|i| (pairs.vectors[(i, 0)] * total.sqrt() - 1.0).abs() < 1e-12));
+}
+
 #[test]
 fn eigenvectors_are_d_orthonormal_with_small_residuals() {
     let (q, mass) = problem(ShapeKind::BumpyPlane, 3000);

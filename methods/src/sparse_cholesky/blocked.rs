@@ -26,6 +26,10 @@
 
 use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
 
+#[cfg(target_arch = "x86_64")]
+use crate::row_major::Fused;
+use crate::row_major::{combine, fma_available, reduce, row, row_mut, MulAdd, Separate};
+
 /// Layout of `L` plus the gather map from faer's value array.
 #[derive(Debug, Default)]
 pub(super) struct BlockedFactor {
@@ -211,100 +215,13 @@ fn to_u32(i: usize) -> u32 {
     u32::try_from(i).expect("matrix order exceeds u32 indices")
 }
 
-fn fma_available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
-/// `acc + a * b`, fused or not.
-trait MulAdd {
-    fn mul_add(acc: f64, a: f64, b: f64) -> f64;
-}
-
-/// Separate multiply and add (any CPU).
-struct Separate;
-impl MulAdd for Separate {
-    #[inline(always)]
-    fn mul_add(acc: f64, a: f64, b: f64) -> f64 {
-        acc + a * b
-    }
-}
-
-/// Fused multiply-add; only used inside functions compiled with the `fma` target feature.
-#[cfg(target_arch = "x86_64")]
-struct Fused;
-#[cfg(target_arch = "x86_64")]
-impl MulAdd for Fused {
-    #[inline(always)]
-    fn mul_add(acc: f64, a: f64, b: f64) -> f64 {
-        a.mul_add(b, acc)
-    }
-}
-
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn solve_avx2_fma<const K: usize, const NA: usize, const LB: usize>(f: &BlockedFactor, x: &mut [f64]) {
     solve::<K, NA, LB, Fused>(f, x);
 }
 
-#[inline(always)]
-fn row<const K: usize>(x: &[f64], i: usize) -> &[f64; K] {
-    x[i * K..i * K + K].try_into().unwrap()
-}
-
-#[inline(always)]
-fn row_mut<const K: usize>(x: &mut [f64], i: usize) -> &mut [f64; K] {
-    (&mut x[i * K..i * K + K]).try_into().unwrap()
-}
-
-/// Sum of `NA` accumulator sets, pairwise in a fixed order.
-#[inline(always)]
-fn reduce<const K: usize, const NA: usize>(mut acc: [[f64; K]; NA]) -> [f64; K] {
-    let mut half = NA;
-    while half > 1 {
-        half /= 2;
-        for u in 0..half {
-            for q in 0..K {
-                acc[u][q] += acc[u + half][q];
-            }
-        }
-    }
-    acc[0]
-}
-
-/// `sum_l coef[l] * x[l, :]` for the row-major `coef.len() x K` block `x`, spread over `NA`
-/// independent accumulator sets (fixed summation order).
-#[inline(always)]
-fn combine<const K: usize, const NA: usize, M: MulAdd>(coef: &[f64], x: &[f64]) -> [f64; K] {
-    debug_assert_eq!(x.len(), coef.len() * K);
-    let mut acc = [[0.0; K]; NA];
-    let cs = coef.chunks_exact(NA);
-    let xs = x.chunks_exact(NA * K);
-    let (c_rest, x_rest) = (cs.remainder(), xs.remainder());
-    for (c, xl) in cs.zip(xs) {
-        for u in 0..NA {
-            for q in 0..K {
-                acc[u][q] = M::mul_add(acc[u][q], c[u], xl[u * K + q]);
-            }
-        }
-    }
-    for u in 0..NA {
-        if u < c_rest.len() {
-            for q in 0..K {
-                acc[u][q] = M::mul_add(acc[u][q], c_rest[u], x_rest[u * K + q]);
-            }
-        }
-    }
-    reduce(acc)
-}
-
-/// `sum_r coef[r] * x[rows[r] - offset, :]`, like [`combine`] but gathering the rows of `x`.
+/// `sum_r coef[r] * x[rows[r] - offset, :]`, like [`combine`](crate::row_major::combine) but gathering the rows of `x`.
 #[inline(always)]
 fn gather_combine<const K: usize, const NA: usize, M: MulAdd>(
     coef: &[f64],

@@ -6,7 +6,7 @@
 //! Cholesky; every application of `OP` is one multi-column back-substitution.
 //!
 //! The basis `V` is kept `D`-orthonormal by block classical Gram–Schmidt applied twice ("twice is
-//! enough", Giraud et al. 2005), i.e. full reorthogonalization with BLAS-3 products, so clusters of
+//! enough", Giraud et al. 2005), i.e. full reorthogonalization ([`super::block_gram_schmidt`]), so clusters of
 //! (near-)multiple eigenvalues are resolved like any other. `H = V^T D OP V` is accumulated from the
 //! projection coefficients, and `OP V_s = V_s H_s + V_r E` holds with `V_r` the last (residual) block.
 //! Rayleigh–Ritz on `H_s` gives Ritz pairs `(theta_i, V_s y_i)` with residual norm `|E y_i|`; a
@@ -14,10 +14,10 @@
 //! diagonal plus the coupling row `E Y`.
 
 use faer::linalg::matmul::matmul;
-use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::SparseColMatRef;
-use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
+use faer::{Accum, Mat, Par, Side};
 
+use super::block_gram_schmidt::{column_norms, orthonormalize_block, project_out, Projector};
 use super::random::SplitMix64;
 use super::{EigenError, EigenOptions, Eigenpairs};
 use crate::sparse_cholesky::{add_to_diagonal, SparseCholesky};
@@ -33,7 +33,14 @@ pub fn smallest_eigenpairs(
     options: &EigenOptions,
 ) -> Result<Eigenpairs, EigenError> {
     let n = mass.len();
-    let k = options.count;
+    // A constant null vector is known exactly: it is deflated rather than computed (see
+    // `constant_null_vector`), and the Krylov method looks for the other `k` eigenpairs.
+    let constant = constant_null_vector(stiffness, mass);
+    let deflated = constant.as_ref().map_or(Mat::zeros(n, 0), |c| c.clone());
+    let k = options.count - deflated.ncols();
+    if k == 0 {
+        return Ok(with_deflated(stiffness, &deflated, Vec::new(), Mat::zeros(n, 0), 0, 0));
+    }
     let b = options.block_size.clamp(1, 64);
     // A multiple of the block size, so that every cycle ends exactly at `basis` columns.
     let basis = options.basis_size.unwrap_or((2 * k).max(k + 4 * b)).max(k + 2 * b).div_ceil(b) * b;
@@ -60,12 +67,21 @@ pub fn smallest_eigenpairs(
     {
         let mut start = Mat::from_fn(n, b, |_, _| rng.symmetric_unit());
         let norms = column_norms(start.as_ref(), mass);
-        orthonormalize_block(start.as_mut(), &norms, v.as_ref().subcols(0, 0), mass, &mut rng);
+        project_out(start.as_mut(), deflated.as_ref(), mass, 2);
+        orthonormalize_block(
+            start.as_mut(),
+            &norms,
+            v.as_ref().subcols(0, 0),
+            deflated.as_ref(),
+            mass,
+            &mut rng,
+        );
         v.as_mut().subcols_mut(0, b).copy_from(start.as_ref());
     }
     let mut current = b; // basis columns, the last block being the residual block
     let mut kept = 0; // leading Ritz vectors kept by the last restart
     let mut applications = 0usize;
+    let mut projector = Projector::default();
 
     for restart in 0..=options.max_restarts {
         while current - b < basis {
@@ -83,12 +99,22 @@ pub fn smallest_eigenpairs(
             // block (and, right after a restart, the kept Ritz vectors): project those out first, then
             // reorthogonalize once against the whole basis to remove what rounding put elsewhere.
             let local = if block == kept { 0 } else { block.saturating_sub(b) };
-            let mut coefficients = Mat::<f64>::zeros(current, b);
-            let c = project_out(w.as_mut(), v.as_ref().subcols(local, current - local), mass, par, 1);
-            coefficients.as_mut().subrows_mut(local, current - local).copy_from(c.as_ref());
-            coefficients += project_out(w.as_mut(), v.as_ref().subcols(0, current), mass, par, 1);
+            // The deflated vectors go first: OP maps their rounding-level components to ~1e8 times
+            // the size of anything else.
+            let bases = [
+                deflated.as_ref(),
+                v.as_ref().subcols(local, current - local),
+                v.as_ref().subcols(0, current),
+            ];
+            let [_, c_local, c_full] =
+                <[Mat<f64>; 3]>::try_from(projector.project_out_in_turn(w.as_mut(), &bases, mass))
+                    .expect("one coefficient block per basis");
+            let mut coefficients = c_full;
+            let mut head = coefficients.as_mut().subrows_mut(local, current - local);
+            head += c_local;
             h.as_mut().submatrix_mut(0, block, current, b).copy_from(coefficients.as_ref());
-            let r = orthonormalize_block(w.as_mut(), &norms, v.as_ref().subcols(0, current), mass, &mut rng);
+            let basis_so_far = v.as_ref().subcols(0, current);
+            let r = orthonormalize_block(w.as_mut(), &norms, basis_so_far, deflated.as_ref(), mass, &mut rng);
             v.as_mut().subcols_mut(current, b).copy_from(w.as_ref());
             h.as_mut().submatrix_mut(current, block, b, b).copy_from(r.as_ref());
             current += b;
@@ -122,13 +148,7 @@ pub fn smallest_eigenpairs(
                 par,
             );
             let values = theta[..k].iter().map(|t| sigma + 1.0 / t).collect();
-            return Ok(Eigenpairs {
-                values,
-                vectors,
-                constant_mode: None,
-                restarts: restart,
-                operator_applications: applications,
-            });
+            return Ok(with_deflated(stiffness, &deflated, values, vectors, restart, applications));
         }
         if restart == options.max_restarts {
             return Err(EigenError::NotConverged { converged, wanted: k, restarts: restart });
@@ -164,6 +184,57 @@ pub fn smallest_eigenpairs(
     unreachable!("the loop returns on its last restart")
 }
 
+/// The `D`-normalized constant vector when it is a null vector of `stiffness` (every row sums to
+/// zero up to rounding, as for a cotangent Laplacian), else `None`.
+///
+/// Deflating it is a matter of accuracy, not only of work: the shift-invert operator maps it to
+/// `theta = 1 / |sigma|`, about `1e8` times the next eigenvalue's, and with it in the Krylov space
+/// every product carries rounding of that size, above the tolerance of the largest wanted `lambda`.
+fn constant_null_vector(stiffness: SparseColMatRef<'_, usize, f64>, mass: &[f64]) -> Option<Mat<f64>> {
+    let (symbolic, values) = stiffness.parts();
+    let mut row_sums = vec![0.0; mass.len()];
+    let mut row_scale = vec![0.0f64; mass.len()];
+    for j in 0..symbolic.ncols() {
+        for idx in symbolic.col_range(j) {
+            let i = symbolic.row_idx()[idx];
+            row_sums[i] += values[idx];
+            row_scale[i] = row_scale[i].max(values[idx].abs());
+        }
+    }
+    let null = row_sums.iter().zip(&row_scale).all(|(s, m)| s.abs() <= 1e-12 * m.max(f64::MIN_POSITIVE));
+    null.then(|| {
+        let value = 1.0 / mass.iter().sum::<f64>().sqrt();
+        Mat::from_fn(mass.len(), 1, |_, _| value)
+    })
+}
+
+/// The Krylov eigenpairs (`values` ascending, `vectors` `#V x k`) with the deflated null vectors
+/// (`#V x d`, eigenvalue their Rayleigh quotient, about 0) in front.
+fn with_deflated(
+    stiffness: SparseColMatRef<'_, usize, f64>,
+    deflated: &Mat<f64>,
+    values: Vec<f64>,
+    vectors: Mat<f64>,
+    restarts: usize,
+    operator_applications: usize,
+) -> Eigenpairs {
+    let d = deflated.ncols();
+    let rayleigh = (0..d).map(|j| {
+        let x = deflated.col(j);
+        let qx = stiffness * x;
+        (0..x.nrows()).map(|i| x[i] * qx[i]).sum::<f64>()
+    });
+    let values = rayleigh.chain(values).collect();
+    let vectors = Mat::from_fn(vectors.nrows(), d + vectors.ncols(), |i, j| {
+        if j < d {
+            deflated[(i, j)]
+        } else {
+            vectors[(i, j - d)]
+        }
+    });
+    Eigenpairs { values, vectors, constant_mode: None, restarts, operator_applications }
+}
+
 fn diagonal(m: SparseColMatRef<'_, usize, f64>) -> Vec<f64> {
     let (symbolic, values) = m.parts();
     (0..symbolic.ncols())
@@ -171,100 +242,4 @@ fn diagonal(m: SparseColMatRef<'_, usize, f64>) -> Vec<f64> {
             symbolic.col_range(j).find(|&idx| symbolic.row_idx()[idx] == j).map_or(0.0, |idx| values[idx])
         })
         .collect()
-}
-
-fn d_dot(a: MatRef<'_, f64>, i: usize, b: MatRef<'_, f64>, j: usize, mass: &[f64]) -> f64 {
-    let (a, b) = (a.col(i), b.col(j));
-    (0..mass.len()).map(|r| mass[r] * a[r] * b[r]).sum()
-}
-
-fn column_norms(w: MatRef<'_, f64>, mass: &[f64]) -> Vec<f64> {
-    (0..w.ncols()).map(|j| d_dot(w, j, w, j, mass).sqrt()).collect()
-}
-
-/// `W <- W - V (V^T D W)`, `passes` times; returns the accumulated coefficients (V's columns x b).
-fn project_out(
-    mut w: MatMut<'_, f64>,
-    v: MatRef<'_, f64>,
-    mass: &[f64],
-    par: Par,
-    passes: usize,
-) -> Mat<f64> {
-    let mut total = Mat::<f64>::zeros(v.ncols(), w.ncols());
-    if v.ncols() == 0 {
-        return total;
-    }
-    let mut dw = Mat::<f64>::zeros(w.nrows(), w.ncols());
-    let mut c = Mat::<f64>::zeros(v.ncols(), w.ncols());
-    for _pass in 0..passes {
-        for j in 0..w.ncols() {
-            for i in 0..w.nrows() {
-                dw[(i, j)] = mass[i] * w[(i, j)];
-            }
-        }
-        matmul(c.as_mut(), Accum::Replace, v.transpose(), dw.as_ref(), 1.0, par);
-        matmul(w.rb_mut(), Accum::Add, v, c.as_ref(), -1.0, par);
-        total += &c;
-    }
-    total
-}
-
-/// `D`-orthonormalize the columns of `W` (already orthogonal to `basis`) by modified Gram–Schmidt
-/// applied twice, returning the upper triangular `R` with `W_in = W_out R`. A column that vanishes
-/// (below 1e-10 of its norm before projection, `norms`) means the Krylov space became invariant; it
-/// is replaced by a random vector orthogonal to everything, with a zero in `R`.
-fn orthonormalize_block(
-    mut w: MatMut<'_, f64>,
-    norms: &[f64],
-    basis: MatRef<'_, f64>,
-    mass: &[f64],
-    rng: &mut SplitMix64,
-) -> Mat<f64> {
-    let b = w.ncols();
-    let mut r = Mat::<f64>::zeros(b, b);
-    for c in 0..b {
-        for _pass in 0..2 {
-            for q in 0..c {
-                let coef = d_dot(w.rb(), q, w.rb(), c, mass);
-                r[(q, c)] += coef;
-                for i in 0..w.nrows() {
-                    let wq = w[(i, q)];
-                    w[(i, c)] -= coef * wq;
-                }
-            }
-        }
-        let norm = d_dot(w.rb(), c, w.rb(), c, mass).sqrt();
-        if norm > 1e-10 * norms[c] && norm > 0.0 {
-            r[(c, c)] = norm;
-            for i in 0..w.nrows() {
-                w[(i, c)] /= norm;
-            }
-            continue;
-        }
-        // Invariant subspace found: continue with a fresh direction.
-        loop {
-            for i in 0..w.nrows() {
-                w[(i, c)] = rng.symmetric_unit();
-            }
-            let before = d_dot(w.rb(), c, w.rb(), c, mass).sqrt();
-            project_out(w.rb_mut().subcols_mut(c, 1), basis, mass, Par::Seq, 2);
-            for _pass in 0..2 {
-                for q in 0..c {
-                    let coef = d_dot(w.rb(), q, w.rb(), c, mass);
-                    for i in 0..w.nrows() {
-                        let wq = w[(i, q)];
-                        w[(i, c)] -= coef * wq;
-                    }
-                }
-            }
-            let norm = d_dot(w.rb(), c, w.rb(), c, mass).sqrt();
-            if norm > 1e-6 * before {
-                for i in 0..w.nrows() {
-                    w[(i, c)] /= norm;
-                }
-                break;
-            }
-        }
-    }
-    r
 }

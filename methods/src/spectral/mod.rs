@@ -4,8 +4,11 @@
 //!
 //! [`smallest_eigenpairs`] solves it by shift-invert block Krylov–Schur (thick-restart block Lanczos)
 //! in the `D` inner product ([`krylov_schur`]); all shift-invert solves reuse one sparse Cholesky
-//! factorization of `Q - sigma D`. Small problems are solved densely ([`dense`]).
+//! factorization of `Q - sigma D`. When `Q` annihilates constants (a Laplacian of a connected mesh
+//! has exactly one such mode), the constant vector is deflated: returned as the first eigenpair and
+//! kept out of the Krylov space. Small problems are solved densely ([`dense`]).
 
+mod block_gram_schmidt;
 mod dense;
 mod krylov_schur;
 mod random;
@@ -44,7 +47,10 @@ impl EigenOptions {
         Self {
             count,
             tolerance: 1e-11,
-            block_size: 4,
+            // Measured on the survey meshes: for few eigenpairs, pairs of vectors need ~30% fewer
+            // operator applications than blocks of 4; for many, blocks of 4 stream the basis
+            // through the orthogonalization at half the passes.
+            block_size: if count <= 50 { 2 } else { 4 },
             basis_size: None,
             max_restarts: 300,
             seed: 0x5eed,
@@ -115,14 +121,25 @@ pub fn smallest_eigenpairs(
     } else {
         krylov_schur::smallest_eigenpairs(stiffness, mass, options)?
     };
-    pairs.constant_mode = find_constant_mode(&pairs, mass);
+    pairs.constant_mode = find_constant_mode(&pairs, stiffness, mass);
     Ok(pairs)
 }
 
 /// The eigenpair with eigenvalue ~0 and a constant eigenvector, if any (one per connected component
 /// would be a constant per component; only the globally constant one is flagged).
-fn find_constant_mode(pairs: &Eigenpairs, mass: &[f64]) -> Option<usize> {
-    let scale = pairs.values.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(f64::MIN_POSITIVE);
+fn find_constant_mode(
+    pairs: &Eigenpairs,
+    stiffness: SparseColMatRef<'_, usize, f64>,
+    mass: &[f64],
+) -> Option<usize> {
+    // The spectrum's scale: the largest eigenvalue found, or (when only a few near 0 were asked
+    // for) the largest `Q_ii / D_ii`, of the order of the largest eigenvalue.
+    let (symbolic, values) = stiffness.parts();
+    let diagonal_scale = (0..symbolic.ncols())
+        .flat_map(|j| symbolic.col_range(j).filter(move |&idx| symbolic.row_idx()[idx] == j))
+        .map(|idx| values[idx].abs() / mass[symbolic.row_idx()[idx]])
+        .fold(0.0f64, f64::max);
+    let scale = pairs.values.iter().fold(diagonal_scale, |m, v| m.max(v.abs())).max(f64::MIN_POSITIVE);
     let total: f64 = mass.iter().sum();
     let constant = 1.0 / total.sqrt(); // D-normalized constant vector
     (0..pairs.values.len()).find(|&j| {
