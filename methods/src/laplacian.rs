@@ -9,9 +9,8 @@
 //! - `L` is the cotangent Laplacian without mass normalization (libigl `cotmatrix`); eq 1 is
 //!   invariant to the sign of `L`.
 //! - `delta(X)` update: the rest Laplacian coordinates `delta_i = (L X_rest)_i` are stored in a local
-//!   frame per vertex (area-weighted vertex normal `n_i`; tangent `t_i` = the edge to the lowest-index
-//!   neighbour projected onto the tangent plane; `b_i = n_i x t_i`) and re-expressed in the frame of
-//!   the current surface each iteration — the rotation-invariant encoding of Lipman et al. 2005, used
+//!   frame per vertex and re-expressed in the frame of the current surface each iteration
+//!   ([`crate::laplacian_coordinates`]) — the rotation-invariant encoding of Lipman et al. 2005, used
 //!   by the iterative frameworks Au 2007 cites [Au et al. 2006; Huang et al. 2006]. The rest shape is a
 //!   fixed point.
 //! - `X^0` is the current shape (eq 3: "the current edited vertex positions"); from the rest shape
@@ -26,12 +25,12 @@ use std::time::Instant;
 use faer::sparse::linalg::matmul::{sparse_dense_matmul, sparse_sparse_matmul};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Accum, Mat, Par};
-use meshes::vector::{cross, dot, normalize_or_zero, scale, sub};
 use meshes::{Topology, TriMesh};
 use serde::Deserialize;
 
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
+use crate::laplacian_coordinates::RotationInvariantCoordinates;
 use crate::method::{finish_iteration, DeformationMethod, IterationObserver, SolveSummary};
 use crate::operators::cotan_laplacian;
 use crate::sparse_cholesky::{add_to_diagonal, SparseCholesky};
@@ -56,13 +55,9 @@ impl Default for LaplacianParams {
 
 /// Rest-state data: operator, rest Laplacian coordinates in local frames.
 struct RestState {
-    triangles: Vec<[u32; 3]>,
     laplacian: SparseColMat<usize, f64>,
     normal_matrix: SparseColMat<usize, f64>,
-    /// Per vertex, the neighbour whose edge defines the tangent `t_i`.
-    frame_neighbor: Vec<u32>,
-    /// `delta_i` of the rest shape as `(n, t, b)` coefficients.
-    frame_coefficients: Vec<[f64; 3]>,
+    coordinates: RotationInvariantCoordinates,
     bbox_diagonal: f64,
 }
 
@@ -73,7 +68,6 @@ pub struct LaplacianEditing {
     cholesky: Option<SparseCholesky>,
     handles: Option<HandleSet>,
     current: Vec<[f64; 3]>,
-    normals: Vec<[f64; 3]>,
     delta: Mat<f64>,
     rhs: Mat<f64>,
 }
@@ -93,7 +87,6 @@ impl LaplacianEditing {
             cholesky: None,
             handles: None,
             current: Vec::new(),
-            normals: Vec::new(),
             delta: Mat::zeros(0, 3),
             rhs: Mat::zeros(0, 3),
         })
@@ -101,30 +94,9 @@ impl LaplacianEditing {
 
     /// The current Laplacian coordinates `delta(X)` (`#V x 3`) into `self.delta`.
     fn update_delta(&mut self) {
-        let rest = self.rest.as_ref().expect("precomputed");
-        meshes::geometry::vertex_normals_into(&self.current, &rest.triangles, &mut self.normals);
-        for i in 0..self.current.len() {
-            let (n, t, b) = local_frame(&self.current, &self.normals, rest.frame_neighbor[i], i);
-            let c = rest.frame_coefficients[i];
-            for a in 0..3 {
-                self.delta[(i, a)] = c[0] * n[a] + c[1] * t[a] + c[2] * b[a];
-            }
-        }
+        let rest = self.rest.as_mut().expect("precomputed");
+        rest.coordinates.evaluate(&self.current, self.delta.as_mut());
     }
-}
-
-/// Orthonormal frame `(n, t, b)` at vertex `i`: the vertex normal, the edge to `neighbor` projected onto
-/// the tangent plane, and their cross product. Degenerate frames come out as zero vectors.
-fn local_frame(
-    positions: &[[f64; 3]],
-    normals: &[[f64; 3]],
-    neighbor: u32,
-    i: usize,
-) -> ([f64; 3], [f64; 3], [f64; 3]) {
-    let n = normals[i];
-    let e = sub(positions[neighbor as usize], positions[i]);
-    let t = normalize_or_zero(sub(e, scale(n, dot(e, n))));
-    (n, t, cross(n, t))
 }
 
 impl DeformationMethod for LaplacianEditing {
@@ -143,37 +115,19 @@ impl DeformationMethod for LaplacianEditing {
         let normal_matrix = sorted(&product);
         self.cholesky = Some(SparseCholesky::analyze(normal_matrix.as_ref())?);
 
-        let rest_positions = Mat::from_fn(n, 3, |i, a| positions[i][a]);
-        let mut rest_delta = Mat::zeros(n, 3);
-        sparse_dense_matmul(
-            rest_delta.as_mut(),
-            Accum::Replace,
+        let coordinates = RotationInvariantCoordinates::new(
+            positions,
+            rest_mesh.triangles(),
+            &topology,
             laplacian.as_ref(),
-            rest_positions.as_ref(),
-            1.0,
-            Par::Seq,
         );
-        let normals = meshes::geometry::vertex_normals(positions, rest_mesh.triangles());
-        let mut frame_neighbor = Vec::with_capacity(n);
-        let mut frame_coefficients = Vec::with_capacity(n);
-        for i in 0..n {
-            // Isolated vertices have no neighbour; they keep a zero delta.
-            let neighbor = topology.one_ring(i).first().copied().unwrap_or(i as u32);
-            let (nn, t, b) = local_frame(positions, &normals, neighbor, i);
-            let d = [rest_delta[(i, 0)], rest_delta[(i, 1)], rest_delta[(i, 2)]];
-            frame_neighbor.push(neighbor);
-            frame_coefficients.push([dot(d, nn), dot(d, t), dot(d, b)]);
-        }
         self.rest = Some(RestState {
-            triangles: rest_mesh.triangles().to_vec(),
             laplacian,
             normal_matrix,
-            frame_neighbor,
-            frame_coefficients,
+            coordinates,
             bbox_diagonal: rest_mesh.bbox_diagonal(),
         });
         self.current = positions.to_vec();
-        self.normals = vec![[0.0; 3]; n];
         self.delta = Mat::zeros(n, 3);
         self.rhs = Mat::zeros(n, 3);
         self.handles = None;

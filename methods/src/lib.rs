@@ -4,7 +4,9 @@
 pub mod arap;
 pub mod error;
 pub mod handles;
+pub mod isolines;
 pub mod laplacian;
+mod laplacian_coordinates;
 pub mod method;
 pub mod operators;
 pub mod registry;

@@ -4,6 +4,7 @@ use serde::de::DeserializeOwned;
 
 use crate::arap::Arap;
 use crate::error::MethodError;
+use crate::isolines::Isolines;
 use crate::laplacian::LaplacianEditing;
 use crate::method::DeformationMethod;
 use crate::spectral_mhb::SpectralMhb;
@@ -34,6 +35,21 @@ pub const METHODS: &[MethodEntry] = &[
         name: "spectral_mhb",
         summary: "spectral mesh deformation in manifold harmonics bases with deformation transfer of details (Rong, Cao & Guo 2008)",
         create: |p| Ok(Box::new(SpectralMhb::new(parse("spectral_mhb", p)?)?)),
+    },
+    MethodEntry {
+        name: "isolines",
+        summary: "handle-aware isolines reduced model (Au, Fu, Tai & Cohen-Or 2007), n_iso = 20, isoline-interpolated Laplacian coordinates (Table 1 t_2)",
+        create: |p| Ok(Box::new(Isolines::new("isolines", parse("isolines", p)?)?)),
+    },
+    MethodEntry {
+        name: "isolines_10",
+        summary: "`isolines` with n_iso = 10 (the coarser model of Au et al. 2007, Fig. 9)",
+        create: |p| Ok(Box::new(Isolines::new("isolines_10", parse("isolines_10", p)?)?)),
+    },
+    MethodEntry {
+        name: "isolines_t1",
+        summary: "`isolines` with vertex interpolation only: Laplacian coordinates on the whole mesh per iteration (Au et al. 2007 eq 6, Table 1 t_1)",
+        create: |p| Ok(Box::new(Isolines::new("isolines_t1", parse("isolines_t1", p)?)?)),
     },
 ];
 

@@ -1,0 +1,433 @@
+//! The reduced domain of Au et al. 2007 and its interpolation to the mesh (sections 4.1–4.3).
+//!
+//! [`IsolineModel`] holds the isolines (`N = #sets x n_iso`, numbered `m = set * n_iso + j`), the
+//! two-level interpolation weights `w_{k,m}` of every vertex (section 4.2: linear between the two
+//! isolines around `phi_{i,k}`, times `phi_{i,k}` across handles), and the sampled crossed triangles
+//! with their base frames. With the weights, `W_x[k, 4m + c] = w_{k,m} x_bar_k[c]` (homogeneous
+//! `x_bar_k`) and `W_delta[k, 3m + c] = w_{k,m} delta_bar_k[c]`; both are applied row by row and never
+//! stored densely (`#V x 4N` would not fit for large meshes with many handles).
+//!
+//! [`ReducedSystem`] is what eq 10 needs: `U^T U` (`4N x 4N`), `W_x^T L^T W_delta` (`4N x 3N`) and the
+//! constraint right-hand side.
+
+use faer::sparse::SparseColMatRef;
+use faer::{Mat, MatRef};
+
+use super::segment_frame;
+use super::tracing::{sample_uniformly, trace_isoline, CrossedTriangle};
+use crate::handles::{HandleSet, HandleTargets};
+
+/// Offset of the special isolines from the boundary values 0 and 1 (see the module docs of
+/// [`super`]).
+const SPECIAL_LEVEL_OFFSET: f64 = 1e-6;
+
+/// One isoline `(set, j)` and its sampled crossed triangles.
+#[derive(Clone, Debug)]
+pub struct Isoline {
+    /// Index of the harmonic field (isoline set) it belongs to.
+    pub set: usize,
+    /// `j`, 0-based: isovalue `j / (n_iso - 1)`.
+    pub index: usize,
+    /// `s_ij`, the isovalue of the interpolation.
+    pub isovalue: f64,
+    /// The level actually traced (the isovalue, or just inside `(0, 1)` for the special isolines).
+    pub level: f64,
+    /// Crossed triangles before sampling.
+    pub crossed_total: usize,
+    /// `Gamma_ij`: the sampled crossed triangles.
+    pub crossed: Vec<CrossedTriangle>,
+}
+
+/// A sampled crossed triangle as the iteration uses it: its corners and segment ends as indices
+/// into the probe vertices, the segment weight `l^2` and the base frame.
+#[derive(Clone, Debug)]
+struct Sample {
+    isoline: u32,
+    corners: [u32; 3],
+    /// `(probe a, probe b, t)` of both segment ends.
+    ends: [(u32, u32, f64); 2],
+    weight: f64,
+    base_frame: [[f64; 3]; 3],
+}
+
+/// The isolines, the interpolation weights and the sampled crossed triangles; see the module docs.
+pub struct IsolineModel {
+    n_iso: usize,
+    n_sets: usize,
+    base: Vec<[f64; 3]>,
+    /// `L x_bar` of the base shape, `#V`.
+    base_delta: Vec<[f64; 3]>,
+    /// CSR rows of `w_{k,m}`: vertex `k` has `entries[row_start[k]..row_start[k + 1]]`.
+    row_start: Vec<usize>,
+    entries: Vec<(u32, f64)>,
+    isolines: Vec<Isoline>,
+    /// Vertices of the sampled triangles.
+    probes: Vec<u32>,
+    samples: Vec<Sample>,
+}
+
+impl IsolineModel {
+    /// Build the model on the `#V x 3` base shape `base` from the `#V x #handles` harmonic fields:
+    /// `n_iso` isolines per set, at most `max_crossed_triangles` sampled triangles in all.
+    /// `delta_bar = L X_base` is filled in by [`ReducedSystem::new`], which has `L`.
+    pub fn new(
+        base: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+        fields: MatRef<'_, f64>,
+        n_iso: usize,
+        max_crossed_triangles: usize,
+    ) -> Self {
+        let n = base.len();
+        // Two handles: one set on the first field (the second is its complement).
+        let n_sets = if fields.ncols() == 2 { 1 } else { fields.ncols() };
+        let field = |k: usize, set: usize| fields[(k, set)].clamp(0.0, 1.0);
+        let mut row_start = Vec::with_capacity(n + 1);
+        let mut entries = Vec::with_capacity(2 * n * n_sets);
+        row_start.push(0);
+        for k in 0..n {
+            for set in 0..n_sets {
+                let set_weight = if n_sets == 1 { 1.0 } else { field(k, set) };
+                if set_weight == 0.0 {
+                    continue;
+                }
+                let position = field(k, set) * (n_iso - 1) as f64;
+                let j = (position.floor() as usize).min(n_iso - 2);
+                let alpha = position - j as f64;
+                let m = (set * n_iso + j) as u32;
+                entries.push((m, set_weight * (1.0 - alpha)));
+                entries.push((m + 1, set_weight * alpha));
+            }
+            row_start.push(entries.len());
+        }
+
+        let per_isoline = (max_crossed_triangles / (n_sets * n_iso)).max(1);
+        let mut isolines = Vec::with_capacity(n_sets * n_iso);
+        let mut values = vec![0.0; n];
+        for set in 0..n_sets {
+            for (k, v) in values.iter_mut().enumerate() {
+                *v = fields[(k, set)];
+            }
+            for j in 0..n_iso {
+                let isovalue = j as f64 / (n_iso - 1) as f64;
+                let level = isovalue.clamp(SPECIAL_LEVEL_OFFSET, 1.0 - SPECIAL_LEVEL_OFFSET);
+                let crossed = trace_isoline(base, triangles, &values, level);
+                let crossed_total = crossed.len();
+                let crossed = sample_uniformly(crossed, per_isoline);
+                isolines.push(Isoline { set, index: j, isovalue, level, crossed_total, crossed });
+            }
+        }
+
+        let mut probe_of = vec![u32::MAX; n];
+        let mut probes = Vec::new();
+        let mut probe = |v: u32| {
+            if probe_of[v as usize] == u32::MAX {
+                probe_of[v as usize] = probes.len() as u32;
+                probes.push(v);
+            }
+            probe_of[v as usize]
+        };
+        let mut samples = Vec::new();
+        for (m, isoline) in isolines.iter().enumerate() {
+            for c in &isoline.crossed {
+                let tri = triangles[c.triangle as usize];
+                let corners = tri.map(&mut probe);
+                let ends = c.ends.map(|e| (probe(e.a), probe(e.b), e.t));
+                let p = tri.map(|v| base[v as usize]);
+                let (q0, q1) = (c.ends[0].position(base), c.ends[1].position(base));
+                samples.push(Sample {
+                    isoline: m as u32,
+                    corners,
+                    ends,
+                    weight: c.length * c.length,
+                    base_frame: segment_frame(p, q0, q1),
+                });
+            }
+        }
+        Self {
+            n_iso,
+            n_sets,
+            base: base.to_vec(),
+            base_delta: Vec::new(),
+            row_start,
+            entries,
+            isolines,
+            probes,
+            samples,
+        }
+    }
+
+    /// Number of isolines `N` (reduced variables: `4N` per coordinate for `R_x`, `3N` for `R_delta`).
+    pub fn n_isolines(&self) -> usize {
+        self.n_sets * self.n_iso
+    }
+
+    /// The isolines, `m = set * n_iso + j`.
+    pub fn isolines(&self) -> &[Isoline] {
+        &self.isolines
+    }
+
+    /// `n_tri`: sampled crossed triangles of all isolines.
+    pub fn n_sampled_triangles(&self) -> usize {
+        self.samples.len()
+    }
+
+    /// Interpolation weights `(m, w_{k,m})` of vertex `k` (they sum to 1).
+    pub fn vertex_weights(&self, k: usize) -> &[(u32, f64)] {
+        &self.entries[self.row_start[k]..self.row_start[k + 1]]
+    }
+
+    /// The `#V x 3` Laplacian coordinates of the base shape, `L X_base`.
+    pub fn base_delta(&self) -> &[[f64; 3]] {
+        &self.base_delta
+    }
+
+    /// `R_x` (`4N x 3`, column per coordinate) of identity transforms: `W_x R_x = X_base`.
+    pub fn identity_transforms(&self) -> Mat<f64> {
+        Mat::from_fn(4 * self.n_isolines(), 3, |row, a| if row % 4 == a { 1.0 } else { 0.0 })
+    }
+
+    /// `R_delta` (`3N x 3`) of identity rotations: `W_delta R_delta = delta_bar`.
+    pub fn identity_rotations(&self) -> Mat<f64> {
+        Mat::from_fn(3 * self.n_isolines(), 3, |row, a| if row % 3 == a { 1.0 } else { 0.0 })
+    }
+
+    /// `(W_x R_x)_k`: vertex `k` under the reduced variables `reduced` (`4N x 3`).
+    pub fn position(&self, k: usize, reduced: MatRef<'_, f64>) -> [f64; 3] {
+        let x = self.base[k];
+        let h = [x[0], x[1], x[2], 1.0];
+        let mut out = [0.0; 3];
+        for &(m, w) in self.vertex_weights(k) {
+            let row = 4 * m as usize;
+            for (a, o) in out.iter_mut().enumerate() {
+                *o += w * (0..4).map(|c| reduced[(row + c, a)] * h[c]).sum::<f64>();
+            }
+        }
+        out
+    }
+
+    /// `W_x R_x` for every vertex, `#V x 3`.
+    pub fn positions(&self, reduced: MatRef<'_, f64>) -> Vec<[f64; 3]> {
+        (0..self.base.len()).map(|k| self.position(k, reduced)).collect()
+    }
+
+    /// `(W_delta R_delta)_k` for the rotations `rotations` (`3N x 3`).
+    pub fn interpolated_delta(&self, k: usize, rotations: MatRef<'_, f64>) -> [f64; 3] {
+        let d = self.base_delta[k];
+        let mut out = [0.0; 3];
+        for &(m, w) in self.vertex_weights(k) {
+            let row = 3 * m as usize;
+            for (a, o) in out.iter_mut().enumerate() {
+                *o += w * (0..3).map(|c| rotations[(row + c, a)] * d[c]).sum::<f64>();
+            }
+        }
+        out
+    }
+
+    /// Positions of the vertices of the sampled triangles under `reduced` (`4N x 3`): all the
+    /// iteration of eq 10 evaluates.
+    pub fn probe_positions(&self, reduced: MatRef<'_, f64>) -> Vec<[f64; 3]> {
+        self.probes.iter().map(|&v| self.position(v as usize, reduced)).collect()
+    }
+
+    /// `R_delta` (`3N x 3`): per isoline the fit of eq 8–9 (with the frame completion of the module
+    /// docs), `r^_m = sum_k l_k^2 F_k F_bar_k^T / sum_k l_k^2`, from the probe positions. An isoline
+    /// without sampled triangles takes the rotation of the nearest one in its set that has some.
+    pub fn isoline_rotations(&self, probes: &[[f64; 3]]) -> Mat<f64> {
+        let n_isolines = self.n_isolines();
+        let mut sums = vec![[[0.0f64; 3]; 3]; n_isolines];
+        let mut weights = vec![0.0f64; n_isolines];
+        for s in &self.samples {
+            let p = s.corners.map(|c| probes[c as usize]);
+            let end = |(a, b, t): (u32, u32, f64)| {
+                let (pa, pb) = (probes[a as usize], probes[b as usize]);
+                std::array::from_fn(|c| (1.0 - t) * pa[c] + t * pb[c])
+            };
+            let frame = segment_frame(p, end(s.ends[0]), end(s.ends[1]));
+            let m = s.isoline as usize;
+            for a in 0..3 {
+                for c in 0..3 {
+                    sums[m][a][c] +=
+                        s.weight * (0..3).map(|col| frame[col][a] * s.base_frame[col][c]).sum::<f64>();
+                }
+            }
+            weights[m] += s.weight;
+        }
+        let mut out = Mat::<f64>::zeros(3 * n_isolines, 3);
+        for set in 0..self.n_sets {
+            let range = set * self.n_iso..(set + 1) * self.n_iso;
+            let fitted: Vec<usize> = range.clone().filter(|&m| weights[m] > 0.0).collect();
+            for m in range {
+                let source = fitted.iter().copied().min_by_key(|&f| f.abs_diff(m));
+                for a in 0..3 {
+                    for c in 0..3 {
+                        out[(3 * m + c, a)] = match source {
+                            Some(f) => sums[f][a][c] / weights[f],
+                            None => f64::from(u8::from(a == c)),
+                        };
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// `W_x` row `k`: `(column, value)` pairs.
+    fn position_row(&self, k: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let x = self.base[k];
+        let h = [x[0], x[1], x[2], 1.0];
+        self.vertex_weights(k)
+            .iter()
+            .flat_map(move |&(m, w)| (0..4).map(move |c| (4 * m as usize + c, w * h[c])))
+    }
+
+    /// `W_delta` row `k`: `(column, value)` pairs.
+    fn delta_row(&self, k: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let d = self.base_delta[k];
+        self.vertex_weights(k)
+            .iter()
+            .flat_map(move |&(m, w)| (0..3).map(move |c| (3 * m as usize + c, w * d[c])))
+    }
+}
+
+/// The matrices of eq 10; see the module docs.
+pub struct ReducedSystem {
+    /// `U^T U`, `4N x 4N`.
+    pub normal_matrix: Mat<f64>,
+    /// `W_x^T L^T W_delta`, `4N x 3N` (empty when `delta` is evaluated on the mesh, the `t_1` variant).
+    pub laplacian_rhs: Mat<f64>,
+    omega: f64,
+}
+
+impl ReducedSystem {
+    /// Build `U^T U = W_x^T L^T L W_x + omega^2 W_x^T Phi^T Phi W_x + beta^2 M^T M` and, when
+    /// `interpolate_delta`, `W_x^T L^T W_delta`; also sets the model's `delta_bar = L X_base`.
+    /// `laplacian`: the `#V x #V` cotangent Laplacian (symmetric).
+    pub fn new(
+        model: &mut IsolineModel,
+        laplacian: SparseColMatRef<'_, usize, f64>,
+        handles: &HandleSet,
+        omega: f64,
+        beta: f64,
+        interpolate_delta: bool,
+    ) -> Self {
+        let n = model.base.len();
+        let (symbolic, values) = laplacian.parts();
+        model.base_delta = (0..n)
+            .map(|r| {
+                let mut d = [0.0; 3];
+                for idx in symbolic.col_range(r) {
+                    let k = symbolic.row_idx()[idx];
+                    for a in 0..3 {
+                        d[a] += values[idx] * model.base[k][a];
+                    }
+                }
+                d
+            })
+            .collect();
+        let size = 4 * model.n_isolines();
+        let mut normal_matrix = Mat::<f64>::zeros(size, size);
+        let mut laplacian_rhs =
+            Mat::<f64>::zeros(size, if interpolate_delta { 3 * model.n_isolines() } else { 0 });
+        // Row r of L W_x, accumulated densely over the touched columns.
+        let mut row = vec![0.0; size];
+        let mut is_touched = vec![false; size];
+        let mut touched: Vec<usize> = Vec::new();
+        for r in 0..n {
+            for idx in symbolic.col_range(r) {
+                let k = symbolic.row_idx()[idx];
+                for (col, v) in model.position_row(k) {
+                    if !is_touched[col] {
+                        is_touched[col] = true;
+                        touched.push(col);
+                    }
+                    row[col] += values[idx] * v;
+                }
+            }
+            for &p in &touched {
+                for &q in &touched {
+                    normal_matrix[(p, q)] += row[p] * row[q];
+                }
+                if interpolate_delta {
+                    for (col, v) in model.delta_row(r) {
+                        laplacian_rhs[(p, col)] += row[p] * v;
+                    }
+                }
+            }
+            for &p in &touched {
+                row[p] = 0.0;
+                is_touched[p] = false;
+            }
+            touched.clear();
+        }
+        let w2 = omega * omega;
+        for v in handles.constrained() {
+            let entries: Vec<(usize, f64)> = model.position_row(v as usize).collect();
+            for &(p, a) in &entries {
+                for &(q, b) in &entries {
+                    normal_matrix[(p, q)] += w2 * a * b;
+                }
+            }
+        }
+        // Eq 5: r_{i,j} - r_{i,j+1} = 0, every entry of the 3x4 transforms (per coordinate 4).
+        let b2 = beta * beta;
+        for set in 0..model.n_sets {
+            for j in 0..model.n_iso - 1 {
+                let m = set * model.n_iso + j;
+                for c in 0..4 {
+                    let (p, q) = (4 * m + c, 4 * (m + 1) + c);
+                    normal_matrix[(p, p)] += b2;
+                    normal_matrix[(q, q)] += b2;
+                    normal_matrix[(p, q)] -= b2;
+                    normal_matrix[(q, p)] -= b2;
+                }
+            }
+        }
+        Self { normal_matrix, laplacian_rhs, omega }
+    }
+
+    /// `omega^2 W_x^T Phi^T H` (`4N x 3`) for the targets `H` of the constrained vertices.
+    pub fn constraint_rhs(
+        &self,
+        model: &IsolineModel,
+        handles: &HandleSet,
+        targets: &HandleTargets,
+    ) -> Mat<f64> {
+        let w2 = self.omega * self.omega;
+        let mut out = Mat::<f64>::zeros(4 * model.n_isolines(), 3);
+        for (v, t) in handles.constrained().zip(targets.positions()) {
+            for (p, value) in model.position_row(v as usize) {
+                for a in 0..3 {
+                    out[(p, a)] += w2 * value * t[a];
+                }
+            }
+        }
+        out
+    }
+
+    /// `W_x^T L^T delta` (`4N x 3`) for `delta` evaluated on the mesh (`#V x 3`; the `t_1` variant).
+    pub fn laplacian_rhs_full(
+        &self,
+        model: &IsolineModel,
+        laplacian: SparseColMatRef<'_, usize, f64>,
+        delta: MatRef<'_, f64>,
+    ) -> Mat<f64> {
+        let (symbolic, values) = laplacian.parts();
+        let mut out = Mat::<f64>::zeros(4 * model.n_isolines(), 3);
+        for k in 0..model.base.len() {
+            // (L delta)_k, L symmetric.
+            let mut y = [0.0; 3];
+            for idx in symbolic.col_range(k) {
+                let i = symbolic.row_idx()[idx];
+                for a in 0..3 {
+                    y[a] += values[idx] * delta[(i, a)];
+                }
+            }
+            for (p, value) in model.position_row(k) {
+                for a in 0..3 {
+                    out[(p, a)] += value * y[a];
+                }
+            }
+        }
+        out
+    }
+}

@@ -1,0 +1,343 @@
+//! `isolines`: the handle-aware isolines reduced model (Au, Fu, Tai & Cohen-Or 2007) of iterative
+//! Laplacian editing.
+//!
+//! Section 4.1: per handle a harmonic field ([`harmonic_fields`]) and `n_iso` isolines at
+//! `s_j = (j - 1) / (n_iso - 1)` ([`tracing`]); every isoline carries a 3x4 affine transform `r_ij`,
+//! the reduced variables. Section 4.2: vertex positions `X = W_x R_x` interpolate the transforms
+//! linearly between neighbouring isolines and blend the handles by their harmonic values
+//! ([`interpolation`]). Section 4.3: Laplacian coordinates `delta = W_delta R_delta` interpolate per
+//! isoline rotations `r^_ij` fitted to the crossed triangles (eq 8–9), so that the iteration of eq 10
+//! only touches the `n_tri` sampled crossed triangles:
+//!
+//! `R_x^{t+1} = (U^T U)^{-1} [(W_x^T L^T W_delta) R_delta^t + omega^2 W_x^T Phi^T H]`,
+//! `U^T U = W_x^T L^T L W_x + omega^2 W_x^T Phi^T Phi W_x + beta^2 M^T M` (eq 5–6),
+//!
+//! separately for x, y and z. [`LaplacianCoordinates::Vertices`] is the paper's intermediate model
+//! with vertex interpolation only (eq 6, Table 1's `t_1`): `delta(W_x R_x)` is evaluated on the whole
+//! mesh every iteration.
+//!
+//! Decisions the paper leaves open (tested in `methods/tests/isolines.rs`):
+//! - Base shape: the reduced model is built on the shape current at `bind_handles` ("a new
+//!   deformation system is set for the new handles based on the most recently edited result",
+//!   section 5); from the rest shape that is the rest mesh. `L` is the rest mesh's cotangent
+//!   Laplacian; `delta_bar = L X_base`.
+//! - Isoline sets: with two handles one set, on the field of the first handle (section 4.1); with
+//!   one handle the model is a single rigid transform and is refused (a handle set needs a second,
+//!   e.g. fixed, region). With three or more, one set per handle, blended by `phi_i` (section 4.2).
+//! - The special isolines at 0 and 1 are traced at `1e-6` and `1 - 1e-6`, just off the handle
+//!   regions, where the field first leaves its boundary value.
+//! - Eq 9 with the normals alone is singular when the crossed triangles' normals are coplanar — every
+//!   isoline that rings a bar or a cylinder. We fit `r^_ij` to the whole frame of each crossed
+//!   triangle at the isoline: its normal (eq 9's term), the segment direction and their cross
+//!   product, all weighted by `l_k^2`. The normal-equation matrix becomes `(sum l_k^2) I` and
+//!   `r^_ij = sum_k l_k^2 F_k F_bar_k^T / sum_k l_k^2`; a rigid motion of the isoline is recovered
+//!   exactly, as with eq 9 where it is invertible.
+//! - `Gamma_ij` sampling: at most `max_crossed_triangles / #isolines` triangles per isoline, every
+//!   `ceil(count / limit)`-th in triangle order. Soft constraints on every handle vertex (the
+//!   four-vertex handle representation of Botsch & Kobbelt is not used: `omega^2 W_x^T Phi^T H` is
+//!   formed once per solve at `O(#constrained)` cost, outside the iterations).
+//! - Step size: the largest displacement of the vertices of the sampled triangles (the only
+//!   positions the iteration computes), over the bounding-box diagonal.
+
+pub mod harmonic_fields;
+pub mod interpolation;
+pub mod tracing;
+
+use std::time::Instant;
+
+use faer::linalg::solvers::{Llt, SolveCore};
+use faer::{Mat, Side};
+use meshes::vector::{cross, dot, normalize_or_zero, scale, sub};
+use meshes::{Topology, TriMesh};
+use serde::Deserialize;
+
+pub use harmonic_fields::harmonic_fields;
+pub use interpolation::{IsolineModel, ReducedSystem};
+
+use crate::error::MethodError;
+use crate::handles::{HandleSet, HandleTargets};
+use crate::laplacian_coordinates::RotationInvariantCoordinates;
+use crate::method::{DeformationMethod, IterationObserver, IterationReport, SolveSummary};
+use crate::operators::cotan_laplacian;
+
+/// How the Laplacian coordinates of eq 1 are evaluated in the reduced iteration.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum LaplacianCoordinates {
+    /// Interpolated from the isoline rotations, `delta = W_delta R_delta` (section 4.3, eq 10):
+    /// per-iteration work depends on `n_tri` only.
+    Isolines,
+    /// `delta(W_x R_x)` on the whole mesh (eq 6; Table 1's `t_1`): per-iteration work `O(#V)`.
+    Vertices,
+}
+
+/// Parameters of [`Isolines`] (configs/methods.toml, sections `[isolines]`, `[isolines_10]`,
+/// `[isolines_t1]`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct IsolinesParams {
+    /// `n_iso`, isolines per handle (the paper: 20).
+    pub isolines: usize,
+    /// Upper bound on `n_tri`, the sampled crossed triangles of all isolines (section 4.3; the
+    /// paper's bar uses 570).
+    pub max_crossed_triangles: usize,
+    /// Weight `beta` of the smoothness term (eq 5; the paper: 0.01).
+    pub beta: f64,
+    /// Soft handle-constraint weight `omega` (eq 6), as in `laplacian`.
+    pub omega: f64,
+    /// `isolines` (the paper's model) or `vertices` (the `t_1` variant).
+    pub laplacian_coordinates: LaplacianCoordinates,
+    /// Iteration limit per solve.
+    pub max_iterations: usize,
+    /// Converged when the step falls below `tolerance x bbox diagonal`.
+    pub tolerance: f64,
+}
+
+impl Default for IsolinesParams {
+    fn default() -> Self {
+        Self {
+            isolines: 20,
+            max_crossed_triangles: 600,
+            beta: 0.01,
+            omega: 1000.0,
+            laplacian_coordinates: LaplacianCoordinates::Isolines,
+            max_iterations: 500,
+            tolerance: 1e-5,
+        }
+    }
+}
+
+/// Rest-mesh data kept between handle sets.
+struct Rest {
+    triangles: Vec<[u32; 3]>,
+    topology: Topology,
+    laplacian: faer::sparse::SparseColMat<usize, f64>,
+    bbox_diagonal: f64,
+}
+
+/// Everything built by `bind_handles`.
+struct Bound {
+    model: IsolineModel,
+    system: ReducedSystem,
+    factor: Llt<f64>,
+    handles: HandleSet,
+    /// `t_1` variant only: `delta(X)` on the whole mesh.
+    coordinates: Option<RotationInvariantCoordinates>,
+}
+
+/// The handle-aware isolines reduced model; see the module documentation.
+pub struct Isolines {
+    name: &'static str,
+    params: IsolinesParams,
+    rest: Option<Rest>,
+    bound: Option<Bound>,
+    /// `#V x 3` shape at the last bind or solve.
+    current: Vec<[f64; 3]>,
+    /// `4N x 3` reduced variables (per coordinate a column) of the current solve.
+    reduced: Mat<f64>,
+    timings: Vec<(&'static str, f64)>,
+}
+
+impl Isolines {
+    /// A method registered as `name` with the given parameters.
+    pub fn new(name: &'static str, params: IsolinesParams) -> Result<Self, MethodError> {
+        if params.isolines < 2
+            || params.max_crossed_triangles == 0
+            || !(params.beta >= 0.0)
+            || !(params.omega > 0.0)
+            || params.max_iterations == 0
+            || !(params.tolerance >= 0.0)
+        {
+            return Err(MethodError::Parameters {
+                method: name,
+                message: "isolines must be >= 2, max_crossed_triangles >= 1, beta >= 0, omega > 0, \
+                          max_iterations >= 1, tolerance >= 0"
+                    .into(),
+            });
+        }
+        Ok(Self {
+            name,
+            params,
+            rest: None,
+            bound: None,
+            current: Vec::new(),
+            reduced: Mat::zeros(0, 3),
+            timings: Vec::new(),
+        })
+    }
+
+    /// The reduced model of the bound handle set (for tests and reports).
+    pub fn model(&self) -> Option<&IsolineModel> {
+        self.bound.as_ref().map(|b| &b.model)
+    }
+}
+
+impl DeformationMethod for Isolines {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn precompute(&mut self, rest: &TriMesh) -> Result<(), MethodError> {
+        let start = Instant::now();
+        let topology = Topology::new(rest)?;
+        let laplacian = cotan_laplacian(rest.positions(), rest.triangles());
+        self.rest = Some(Rest {
+            triangles: rest.triangles().to_vec(),
+            topology,
+            laplacian,
+            bbox_diagonal: rest.bbox_diagonal(),
+        });
+        self.bound = None;
+        self.current = rest.positions().to_vec();
+        self.timings = vec![("precompute_laplacian", start.elapsed().as_secs_f64())];
+        Ok(())
+    }
+
+    fn bind_handles(&mut self, handles: &HandleSet) -> Result<(), MethodError> {
+        let Some(rest) = &self.rest else {
+            return Err(MethodError::Phase {
+                method: self.name,
+                phase: "bind_handles",
+                missing: "precompute",
+            });
+        };
+        handles.check_mesh_size(self.current.len())?;
+        if handles.regions().len() < 2 {
+            return Err(MethodError::Handles(format!(
+                "`{}` needs at least two handle regions (e.g. a handle and the fixed region): one handle \
+                 gives a constant harmonic field and no isolines",
+                self.name
+            )));
+        }
+        let t0 = Instant::now();
+        let fields = harmonic_fields(rest.laplacian.as_ref(), handles)?;
+        let t1 = Instant::now();
+        let mut model = IsolineModel::new(
+            &self.current,
+            &rest.triangles,
+            fields.as_ref(),
+            self.params.isolines,
+            self.params.max_crossed_triangles,
+        );
+        let t2 = Instant::now();
+        let system = ReducedSystem::new(
+            &mut model,
+            rest.laplacian.as_ref(),
+            handles,
+            self.params.omega,
+            self.params.beta,
+            self.params.laplacian_coordinates == LaplacianCoordinates::Isolines,
+        );
+        let factor = system
+            .normal_matrix
+            .as_ref()
+            .llt(Side::Lower)
+            .map_err(|_| MethodError::Solver(crate::sparse_cholesky::SolverError::NotPositiveDefinite))?;
+        let coordinates = (self.params.laplacian_coordinates == LaplacianCoordinates::Vertices).then(|| {
+            RotationInvariantCoordinates::new(
+                &self.current,
+                &rest.triangles,
+                &rest.topology,
+                rest.laplacian.as_ref(),
+            )
+        });
+        let t3 = Instant::now();
+        self.reduced = model.identity_transforms();
+        self.timings.retain(|(k, _)| *k == "precompute_laplacian");
+        self.timings.extend([
+            ("bind_harmonic_fields", (t1 - t0).as_secs_f64()),
+            ("bind_isolines", (t2 - t1).as_secs_f64()),
+            ("bind_reduced_system", (t3 - t2).as_secs_f64()),
+        ]);
+        self.bound = Some(Bound { model, system, factor, handles: handles.clone(), coordinates });
+        Ok(())
+    }
+
+    fn solve(
+        &mut self,
+        targets: &HandleTargets,
+        observer: &mut dyn IterationObserver,
+    ) -> Result<SolveSummary, MethodError> {
+        let name = self.name;
+        let (Some(rest), Some(bound)) = (&self.rest, &mut self.bound) else {
+            return Err(MethodError::Phase { method: name, phase: "solve", missing: "bind_handles" });
+        };
+        let t0 = Instant::now();
+        let constraint_rhs = bound.system.constraint_rhs(&bound.model, &bound.handles, targets);
+        let mut probes = bound.model.probe_positions(self.reduced.as_ref());
+        let mut delta =
+            Mat::<f64>::zeros(if bound.coordinates.is_some() { self.current.len() } else { 0 }, 3);
+        let mut summary = SolveSummary { iterations: 0, converged: false, final_step: f64::INFINITY };
+        let setup = t0.elapsed().as_secs_f64();
+        for iteration in 0..self.params.max_iterations {
+            let start = Instant::now();
+            let mut rhs = constraint_rhs.clone();
+            match &mut bound.coordinates {
+                None => {
+                    let rotations = bound.model.isoline_rotations(&probes);
+                    rhs += &bound.system.laplacian_rhs * &rotations;
+                }
+                Some(coordinates) => {
+                    let shape = bound.model.positions(self.reduced.as_ref());
+                    coordinates.evaluate(&shape, delta.as_mut());
+                    rhs += bound.system.laplacian_rhs_full(
+                        &bound.model,
+                        rest.laplacian.as_ref(),
+                        delta.as_ref(),
+                    );
+                }
+            }
+            bound.factor.solve_in_place_with_conj(faer::Conj::No, rhs.as_mut());
+            if let Some((row, _)) = (0..rhs.nrows())
+                .flat_map(|r| (0..3).map(move |a| (r, a)))
+                .find(|&(r, a)| !rhs[(r, a)].is_finite())
+            {
+                return Err(MethodError::NonFinite { method: name, vertex: row, iteration });
+            }
+            self.reduced = rhs;
+            let next = bound.model.probe_positions(self.reduced.as_ref());
+            let step = crate::method::max_displacement(&probes, &next) / rest.bbox_diagonal;
+            probes = next;
+            let report = IterationReport { iteration, step, seconds: start.elapsed().as_secs_f64() };
+            summary = SolveSummary {
+                iterations: iteration + 1,
+                converged: step < self.params.tolerance,
+                final_step: step,
+            };
+            let (model, reduced) = (&bound.model, &self.reduced);
+            let flow = observer.on_iteration(&report, &|| model.positions(reduced.as_ref()));
+            if summary.converged || flow.is_break() {
+                break;
+            }
+        }
+        let t1 = Instant::now();
+        self.current = bound.model.positions(self.reduced.as_ref());
+        if let Some(i) = self.current.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(MethodError::NonFinite { method: name, vertex: i, iteration: summary.iterations });
+        }
+        self.timings.retain(|(k, _)| !k.starts_with("solve_"));
+        self.timings.extend([
+            ("solve_constraint_rhs", setup),
+            ("solve_vertex_positions", t1.elapsed().as_secs_f64()),
+        ]);
+        Ok(summary)
+    }
+
+    fn positions(&self) -> Vec<[f64; 3]> {
+        self.current.clone()
+    }
+
+    fn phase_timings(&self) -> Vec<(&'static str, f64)> {
+        self.timings.clone()
+    }
+}
+
+/// Orthonormal frame (normal, segment direction, their cross product) of a crossed triangle with
+/// corners `p` and the isoline segment from `q0` to `q1`, as the columns of a 3x3 matrix.
+pub(crate) fn segment_frame(p: [[f64; 3]; 3], q0: [f64; 3], q1: [f64; 3]) -> [[f64; 3]; 3] {
+    let normal = normalize_or_zero(cross(sub(p[1], p[0]), sub(p[2], p[0])));
+    let along = sub(q1, q0);
+    // Remove any normal component rounding left, so the frame stays orthonormal.
+    let along = normalize_or_zero(sub(along, scale(normal, dot(along, normal))));
+    [normal, along, cross(normal, along)]
+}
