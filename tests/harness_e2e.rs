@@ -78,6 +78,15 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
         let arap = rows.iter().find(|r| r["scenario"] == scenario && r["method"] == "arap").unwrap();
         assert_eq!(num(arap, "rms_to_arap_over_diag"), 0.0);
     }
+    // Au et al. 2007, Fig. 9: on the bar twist, fewer isolines show more of the linear effect (kinks
+    // between isolines). 20 isolines must bend no worse than 10 (E_phi) and stay no farther from the
+    // nonlinear reference (RMS to arap). E_theta is not part of the claim: measured, 20 isolines are
+    // 2% worse there (7.68 vs 7.53 degrees).
+    let bar = |method: &str| rows.iter().find(|r| r["scenario"] == "bar" && r["method"] == method).unwrap();
+    for key in ["e_phi_deg", "rms_to_arap_over_diag"] {
+        let (fine, coarse) = (num(bar("isolines"), key), num(bar("isolines_10"), key));
+        assert!(fine <= coarse, "bar: {key} with 20 isolines {fine} > with 10 {coarse}");
+    }
     let json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(reports.path().join("results.json")).unwrap()).unwrap();
     let cases = json["cases"].as_array().unwrap();
