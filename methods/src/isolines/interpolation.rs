@@ -229,6 +229,11 @@ impl IsolineModel {
         self.probes.iter().map(|&v| self.position(v as usize, reduced)).collect()
     }
 
+    /// The mesh vertex of probe `i` (the order of [`IsolineModel::probe_positions`]).
+    pub fn probe_vertex(&self, i: usize) -> u32 {
+        self.probes[i]
+    }
+
     /// `R_delta` (`3N x 3`): per isoline the fit of eq 8–9 (with the frame completion of the module
     /// docs), `r^_m = sum_k l_k^2 F_k F_bar_k^T / sum_k l_k^2`, from the probe positions. An isoline
     /// without sampled triangles takes the rotation of the nearest one in its set that has some.

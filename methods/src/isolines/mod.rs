@@ -288,14 +288,12 @@ impl DeformationMethod for Isolines {
                 }
             }
             bound.factor.solve_in_place_with_conj(faer::Conj::No, rhs.as_mut());
-            if let Some((row, _)) = (0..rhs.nrows())
-                .flat_map(|r| (0..3).map(move |a| (r, a)))
-                .find(|&(r, a)| !rhs[(r, a)].is_finite())
-            {
-                return Err(MethodError::NonFinite { method: name, vertex: row, iteration });
-            }
             self.reduced = rhs;
             let next = bound.model.probe_positions(self.reduced.as_ref());
+            if let Some(i) = next.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+                let vertex = bound.model.probe_vertex(i) as usize;
+                return Err(MethodError::NonFinite { method: name, vertex, iteration });
+            }
             let step = crate::method::max_displacement(&probes, &next) / rest.bbox_diagonal;
             probes = next;
             let report = IterationReport { iteration, step, seconds: start.elapsed().as_secs_f64() };
