@@ -24,7 +24,7 @@ use crate::row_major::{combine, fma_available, row_mut, MulAdd, Separate};
 const ROWS: usize = 256;
 
 /// Below this many entries of `V` (`#V x m`) one thread does the whole product.
-const PARALLEL_MIN_ENTRIES: usize = 1 << 17;
+const PARALLEL_MIN_ENTRIES: usize = 1 << 20;
 
 /// `<a_i, b_j>_D` for columns `i` of `a` and `j` of `b`.
 pub(super) fn d_dot(a: MatRef<'_, f64>, i: usize, b: MatRef<'_, f64>, j: usize, mass: &[f64]) -> f64 {
