@@ -20,6 +20,10 @@ pub enum MethodError {
     // Not `#[from]`: that would also make it the error's source, and chains would print it twice.
     #[error("linear solver: {0}")]
     Solver(SolverError),
+    #[error("`{method}`: the background precompute thread panicked")]
+    Background { method: &'static str },
+    #[error("eigensolver: {0}")]
+    Eigen(crate::spectral::EigenError),
     #[error("`{method}` produced a non-finite position at vertex {vertex} in iteration {iteration}")]
     NonFinite { method: &'static str, vertex: usize, iteration: usize },
 }

@@ -4,6 +4,7 @@
 pub mod arap;
 pub mod error;
 pub mod handles;
+pub mod hirm;
 pub mod isolines;
 pub mod laplacian;
 mod laplacian_coordinates;

@@ -80,6 +80,12 @@ pub trait DeformationMethod: Send {
     fn phase_timings(&self) -> Vec<(&'static str, f64)> {
         Vec::new()
     }
+
+    /// Sizes describing a reduced model (e.g. HIRM's `n_field` and `n_t`, Au et al.'s `n_tri`),
+    /// reported next to the timings. Counts, not seconds.
+    fn model_statistics(&self) -> Vec<(&'static str, f64)> {
+        Vec::new()
+    }
 }
 
 /// Largest displacement between two `#V x 3` position arrays.

@@ -4,6 +4,7 @@ use serde::de::DeserializeOwned;
 
 use crate::arap::Arap;
 use crate::error::MethodError;
+use crate::hirm::Hirm;
 use crate::isolines::Isolines;
 use crate::laplacian::LaplacianEditing;
 use crate::method::DeformationMethod;
@@ -30,6 +31,11 @@ pub const METHODS: &[MethodEntry] = &[
         name: "arap",
         summary: "As-Rigid-As-Possible surface modeling (Sorkine & Alexa 2007), cotangent weights, hard constraints",
         create: |p| Ok(Box::new(Arap::new(parse("arap", p)?)?)),
+    },
+    MethodEntry {
+        name: "hirm",
+        summary: "handle-independent reduced model for incremental editing: isolines of Laplacian eigenvectors, background precompute (Wu, Au, Tai & Lu 2015)",
+        create: |p| Ok(Box::new(Hirm::new(parse("hirm", p)?)?)),
     },
     MethodEntry {
         name: "spectral_mhb",

@@ -66,6 +66,15 @@ pub fn closest_rotation_warm(m: &Mat3, frame: &mut Mat3) -> Mat3 {
     r
 }
 
+/// The singular values of `m`, descending (square roots of the eigenvalues of `m^T m`).
+pub fn singular_values(m: &Mat3) -> [f64; 3] {
+    let mtm: Mat3 = std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| m[k][i] * m[k][j]).sum()));
+    let (eigenvalues, _) = symmetric_eigen3(mtm);
+    let mut s = eigenvalues.map(|e| e.max(0.0).sqrt());
+    s.sort_by(|a, b| b.total_cmp(a));
+    s
+}
+
 const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 /// Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations: `(eigenvalues, V)` with

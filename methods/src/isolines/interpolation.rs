@@ -13,13 +13,27 @@
 use faer::sparse::SparseColMatRef;
 use faer::{Mat, MatRef};
 
+use meshes::vector::{cross, dot, normalize_or_zero, scale, sub};
+
 use super::segment_frame;
 use super::tracing::{sample_uniformly, trace_isoline, CrossedTriangle};
 use crate::handles::{HandleSet, HandleTargets};
+use crate::rotation_fit::{closest_rotation, singular_values, Mat3};
 
 /// Offset of the special isolines from the boundary values 0 and 1 (see the module docs of
 /// [`super`]).
 const SPECIAL_LEVEL_OFFSET: f64 = 1e-6;
+
+/// How the per-set interpolated transforms are blended into one per vertex (the second level of
+/// the two-level interpolation). The weights of every vertex sum to 1.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SetBlend {
+    /// By the field values at the vertex, `phi_{i,k}` (Au et al. 2007, section 4.2; the harmonic
+    /// fields of all handles sum to 1).
+    FieldValues,
+    /// By one constant weight per set (HIRM eq 8, the normalized importances `omega_bar_i`).
+    PerSet(Vec<f64>),
+}
 
 /// One isoline `(set, j)` and its sampled crossed triangles.
 #[derive(Clone, Debug)]
@@ -48,6 +62,8 @@ struct Sample {
     ends: [(u32, u32, f64); 2],
     weight: f64,
     base_frame: [[f64; 3]; 3],
+    /// The corners minus their centroid and the scaled normal on the base shape (eq 17 of HIRM).
+    base_points: [[f64; 3]; 4],
 }
 
 /// The isolines, the interpolation weights and the sampled crossed triangles; see the module docs.
@@ -67,26 +83,35 @@ pub struct IsolineModel {
 }
 
 impl IsolineModel {
-    /// Build the model on the `#V x 3` base shape `base` from the `#V x #handles` harmonic fields:
-    /// `n_iso` isolines per set, at most `max_crossed_triangles` sampled triangles in all.
-    /// `delta_bar = L X_base` is filled in by [`ReducedSystem::new`], which has `L`.
+    /// Build the model on the `#V x 3` base shape `base` from `#V x #sets` scalar fields with values
+    /// in `[0, 1]` (one isoline set per column): `n_iso` isolines per set, at most
+    /// `max_crossed_triangles` sampled triangles in all, sets blended by `blend`.
+    /// `delta_bar = L X_base` is filled in by [`ReducedSystem::handle_independent`], which has `L`.
     pub fn new(
         base: &[[f64; 3]],
         triangles: &[[u32; 3]],
         fields: MatRef<'_, f64>,
+        blend: &SetBlend,
         n_iso: usize,
         max_crossed_triangles: usize,
     ) -> Self {
         let n = base.len();
-        // Two handles: one set on the first field (the second is its complement).
-        let n_sets = if fields.ncols() == 2 { 1 } else { fields.ncols() };
+        let n_sets = fields.ncols();
+        assert!(n_sets >= 1 && n_iso >= 2, "at least one isoline set of two isolines");
+        if let SetBlend::PerSet(weights) = blend {
+            assert_eq!(weights.len(), n_sets, "one blending weight per isoline set");
+        }
         let field = |k: usize, set: usize| fields[(k, set)].clamp(0.0, 1.0);
         let mut row_start = Vec::with_capacity(n + 1);
         let mut entries = Vec::with_capacity(2 * n * n_sets);
         row_start.push(0);
         for k in 0..n {
             for set in 0..n_sets {
-                let set_weight = if n_sets == 1 { 1.0 } else { field(k, set) };
+                let set_weight = match blend {
+                    _ if n_sets == 1 => 1.0,
+                    SetBlend::FieldValues => field(k, set),
+                    SetBlend::PerSet(weights) => weights[set],
+                };
                 if set_weight == 0.0 {
                     continue;
                 }
@@ -140,6 +165,7 @@ impl IsolineModel {
                     ends,
                     weight: c.length * c.length,
                     base_frame: segment_frame(p, q0, q1),
+                    base_points: centered_points(p),
                 });
             }
         }
@@ -234,10 +260,37 @@ impl IsolineModel {
         self.probes[i]
     }
 
-    /// `R_delta` (`3N x 3`): per isoline the fit of eq 8–9 (with the frame completion of the module
-    /// docs), `r^_m = sum_k l_k^2 F_k F_bar_k^T / sum_k l_k^2`, from the probe positions. An isoline
+    /// `R_delta` (`3N x 3`, the transpose of `r^_m` in rows `3m..3m + 3`): per isoline the rotation
+    /// fitted to its sampled crossed triangles at the probe positions `probes` by `fit`. An isoline
     /// without sampled triangles takes the rotation of the nearest one in its set that has some.
-    pub fn isoline_rotations(&self, probes: &[[f64; 3]]) -> Mat<f64> {
+    pub fn isoline_rotations(&self, probes: &[[f64; 3]], fit: RotationFit) -> Mat<f64> {
+        let fitted = match fit {
+            RotationFit::SegmentFrames => self.segment_frame_rotations(probes),
+            RotationFit::ScaledOrthogonal => self.scaled_orthogonal_rotations(probes),
+        };
+        let n_isolines = self.n_isolines();
+        let mut out = Mat::<f64>::zeros(3 * n_isolines, 3);
+        for set in 0..self.n_sets {
+            let range = set * self.n_iso..(set + 1) * self.n_iso;
+            let with_fit: Vec<usize> = range.clone().filter(|&m| fitted[m].is_some()).collect();
+            for m in range {
+                let source = with_fit.iter().copied().min_by_key(|&f| f.abs_diff(m));
+                for a in 0..3 {
+                    for c in 0..3 {
+                        out[(3 * m + c, a)] = match source {
+                            Some(f) => fitted[f].expect("chosen among the fitted")[a][c],
+                            None => f64::from(u8::from(a == c)),
+                        };
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Au et al. 2007 eq 8–9 with the frame completion of the module docs:
+    /// `r^_m = sum_k l_k^2 F_k F_bar_k^T / sum_k l_k^2`; `None` for isolines without samples.
+    fn segment_frame_rotations(&self, probes: &[[f64; 3]]) -> Vec<Option<Mat3>> {
         let n_isolines = self.n_isolines();
         let mut sums = vec![[[0.0f64; 3]; 3]; n_isolines];
         let mut weights = vec![0.0f64; n_isolines];
@@ -257,23 +310,49 @@ impl IsolineModel {
             }
             weights[m] += s.weight;
         }
-        let mut out = Mat::<f64>::zeros(3 * n_isolines, 3);
-        for set in 0..self.n_sets {
-            let range = set * self.n_iso..(set + 1) * self.n_iso;
-            let fitted: Vec<usize> = range.clone().filter(|&m| weights[m] > 0.0).collect();
-            for m in range {
-                let source = fitted.iter().copied().min_by_key(|&f| f.abs_diff(m));
+        sums.iter()
+            .zip(&weights)
+            .map(|(sum, &w)| (w > 0.0).then(|| sum.map(|row| row.map(|v| v / w))))
+            .collect()
+    }
+
+    /// HIRM eq 17–19: `r~_m` is the least-squares map of the centered corners of the base triangles
+    /// onto the current ones (eq 17), `r^_m = s_m orth(r~_m)` with `s_m = 3 / trace(Sigma)` of the
+    /// SVD `r~_m = U Sigma V^T` (eq 18–19).
+    ///
+    /// Decision: each triangle also maps its unit normal, scaled by the RMS distance of its corners
+    /// from the centroid, onto the current one. Without it eq 17 is singular for an isoline whose
+    /// triangles are coplanar (a flat region); with it a rigid motion is still recovered exactly.
+    fn scaled_orthogonal_rotations(&self, probes: &[[f64; 3]]) -> Vec<Option<Mat3>> {
+        let n_isolines = self.n_isolines();
+        // Per isoline: A = sum current base^T, B = sum base base^T (eq 17's normal equations).
+        let mut cross_sums = vec![[[0.0f64; 3]; 3]; n_isolines];
+        let mut base_sums = vec![[[0.0f64; 3]; 3]; n_isolines];
+        for s in &self.samples {
+            let current = centered_points(s.corners.map(|c| probes[c as usize]));
+            let m = s.isoline as usize;
+            for (q, p) in current.iter().zip(&s.base_points) {
                 for a in 0..3 {
                     for c in 0..3 {
-                        out[(3 * m + c, a)] = match source {
-                            Some(f) => sums[f][a][c] / weights[f],
-                            None => f64::from(u8::from(a == c)),
-                        };
+                        cross_sums[m][a][c] += q[a] * p[c];
+                        base_sums[m][a][c] += p[a] * p[c];
                     }
                 }
             }
         }
-        out
+        cross_sums
+            .iter()
+            .zip(&base_sums)
+            .map(|(a, b)| {
+                let fit = matmul3(a, &inverse3(b)?);
+                let singular_sum: f64 = singular_values(&fit).iter().sum();
+                if !(singular_sum > 0.0 && singular_sum.is_finite()) {
+                    return None;
+                }
+                let scale = 3.0 / singular_sum;
+                Some(closest_rotation(&fit).map(|row| row.map(|v| scale * v)))
+            })
+            .collect()
     }
 
     /// `W_x` row `k`: `(column, value)` pairs.
@@ -294,24 +373,63 @@ impl IsolineModel {
     }
 }
 
-/// The matrices of eq 10; see the module docs.
-pub struct ReducedSystem {
-    /// `U^T U`, `4N x 4N`.
-    pub normal_matrix: Mat<f64>,
-    /// `W_x^T L^T W_delta`, `4N x 3N` (empty when `delta` is evaluated on the mesh, the `t_1` variant).
-    pub laplacian_rhs: Mat<f64>,
-    omega: f64,
+/// How [`IsolineModel::isoline_rotations`] fits one rotation per isoline to its crossed triangles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RotationFit {
+    /// Au et al. 2007 eq 8–9: the average of the segment frames' rotations (module docs of
+    /// [`super`]).
+    SegmentFrames,
+    /// HIRM eq 17–19: least-squares map of the triangles' corners, its rotation by SVD, scaled by
+    /// `3 / trace(Sigma)` to cancel the shrinking of linear interpolation.
+    ScaledOrthogonal,
 }
 
-impl ReducedSystem {
-    /// Build `U^T U = W_x^T L^T L W_x + omega^2 W_x^T Phi^T Phi W_x + beta^2 M^T M` and, when
-    /// `interpolate_delta`, `W_x^T L^T W_delta`; also sets the model's `delta_bar = L X_base`.
-    /// `laplacian`: the `#V x #V` cotangent Laplacian (symmetric).
+/// The three corners of a triangle minus their centroid, and its unit normal scaled by the RMS
+/// distance of the corners from the centroid (zero for a degenerate triangle).
+fn centered_points(p: [[f64; 3]; 3]) -> [[f64; 3]; 4] {
+    let centroid: [f64; 3] = std::array::from_fn(|c| (p[0][c] + p[1][c] + p[2][c]) / 3.0);
+    let offsets = p.map(|q| sub(q, centroid));
+    let rms = (offsets.iter().map(|o| dot(*o, *o)).sum::<f64>() / 3.0).sqrt();
+    let normal = normalize_or_zero(cross(sub(p[1], p[0]), sub(p[2], p[0])));
+    [offsets[0], offsets[1], offsets[2], scale(normal, rms)]
+}
+
+fn matmul3(a: &Mat3, b: &Mat3) -> Mat3 {
+    std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
+}
+
+/// Inverse of a 3x3 matrix by cofactors; `None` when it is singular relative to its scale.
+fn inverse3(m: &Mat3) -> Option<Mat3> {
+    let cof = |i: usize, j: usize| {
+        let (r0, r1) = ((i + 1) % 3, (i + 2) % 3);
+        let (c0, c1) = ((j + 1) % 3, (j + 2) % 3);
+        m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0]
+    };
+    let det: f64 = (0..3).map(|j| m[0][j] * cof(0, j)).sum();
+    let scale = m.iter().flatten().fold(0.0f64, |a, v| a.max(v.abs()));
+    if !(det.abs() > 1e-12 * scale * scale * scale) {
+        return None;
+    }
+    Some(std::array::from_fn(|i| std::array::from_fn(|j| cof(j, i) / det)))
+}
+
+/// The handle-independent part of eq 10's matrices (HIRM eq 23–25 calls them `T_1` and `T_2`):
+/// they depend on the base shape and the isolines only, so HIRM computes them in the background and
+/// a new handle set only adds its constraint term.
+pub struct HandleIndependentSystem {
+    /// `T_1 = W_x^T L^T L W_x + beta^2 M^T M`, `4N x 4N`.
+    pub smoothness_normal_matrix: Mat<f64>,
+    /// `W_x^T L^T W_delta`, `4N x 3N` (empty when `delta` is evaluated on the mesh, the `t_1`
+    /// variant); `T_2 = W_x^T L^T W_delta R_delta`.
+    pub laplacian_rhs: Mat<f64>,
+}
+
+impl HandleIndependentSystem {
+    /// Build `T_1` and, when `interpolate_delta`, `W_x^T L^T W_delta`; also sets the model's
+    /// `delta_bar = L X_base`. `laplacian`: the `#V x #V` cotangent Laplacian (symmetric).
     pub fn new(
         model: &mut IsolineModel,
         laplacian: SparseColMatRef<'_, usize, f64>,
-        handles: &HandleSet,
-        omega: f64,
         beta: f64,
         interpolate_delta: bool,
     ) -> Self {
@@ -364,16 +482,8 @@ impl ReducedSystem {
             }
             touched.clear();
         }
-        let w2 = omega * omega;
-        for v in handles.constrained() {
-            let entries: Vec<(usize, f64)> = model.position_row(v as usize).collect();
-            for &(p, a) in &entries {
-                for &(q, b) in &entries {
-                    normal_matrix[(p, q)] += w2 * a * b;
-                }
-            }
-        }
-        // Eq 5: r_{i,j} - r_{i,j+1} = 0, every entry of the 3x4 transforms (per coordinate 4).
+        // Eq 5 (HIRM eq 12): r_{i,j} - r_{i,j+1} = 0, every entry of the 3x4 transforms (per
+        // coordinate 4).
         let b2 = beta * beta;
         for set in 0..model.n_sets {
             for j in 0..model.n_iso - 1 {
@@ -387,7 +497,115 @@ impl ReducedSystem {
                 }
             }
         }
-        Self { normal_matrix, laplacian_rhs, omega }
+        Self { smoothness_normal_matrix: normal_matrix, laplacian_rhs }
+    }
+
+    /// `U^T U = T_1 + omega^2 (Phi W_x)^T (Phi W_x)` (eq 6; HIRM eq 26) for the constrained vertices
+    /// of `handles`, `4N x 4N`.
+    pub fn constrained_normal_matrix(
+        &self,
+        model: &IsolineModel,
+        handles: &HandleSet,
+        omega: f64,
+    ) -> Mat<f64> {
+        // Row k of Phi W_x is w_k (x) (x_k, 1): per isoline m of vertex k, 4 contiguous columns.
+        // Accumulate in a dense block over the isolines the handles touch (a few hundred
+        // columns, in cache) with 4-wide updates, then add the block to T_1 once.
+        let w2 = omega * omega;
+        let mut local_of = vec![usize::MAX; model.n_isolines()];
+        let mut touched: Vec<usize> = Vec::new();
+        for v in handles.constrained() {
+            for &(m, _) in model.vertex_weights(v as usize) {
+                if local_of[m as usize] == usize::MAX {
+                    local_of[m as usize] = touched.len();
+                    touched.push(m as usize);
+                }
+            }
+        }
+        let c = 4 * touched.len();
+        let mut block = vec![0.0f64; c * c]; // column major
+        for v in handles.constrained() {
+            let x = model.base[v as usize];
+            let h = [x[0], x[1], x[2], 1.0];
+            let weights = model.vertex_weights(v as usize);
+            for &(mq, wq) in weights {
+                let lq = 4 * local_of[mq as usize];
+                for (d, hd) in h.iter().enumerate() {
+                    let column = &mut block[(lq + d) * c..(lq + d + 1) * c];
+                    let s = w2 * wq * hd;
+                    for &(mp, wp) in weights {
+                        let lp = 4 * local_of[mp as usize];
+                        let f = s * wp;
+                        for (e, he) in h.iter().enumerate() {
+                            column[lp + e] += f * he;
+                        }
+                    }
+                }
+            }
+        }
+        let mut normal_matrix = self.smoothness_normal_matrix.clone();
+        for (lq, &mq) in touched.iter().enumerate() {
+            for d in 0..4 {
+                let column = normal_matrix
+                    .col_mut(4 * mq + d)
+                    .try_as_col_major_mut()
+                    .expect("owned matrix")
+                    .as_slice_mut();
+                let local = &block[(4 * lq + d) * c..(4 * lq + d + 1) * c];
+                for (lp, &mp) in touched.iter().enumerate() {
+                    for e in 0..4 {
+                        column[4 * mp + e] += local[4 * lp + e];
+                    }
+                }
+            }
+        }
+        normal_matrix
+    }
+}
+
+/// `omega^2 W_x^T Phi^T H` (`4N x 3`) for the targets `H` of the constrained vertices of `handles`.
+pub fn constraint_rhs(
+    model: &IsolineModel,
+    handles: &HandleSet,
+    targets: &HandleTargets,
+    omega: f64,
+) -> Mat<f64> {
+    let w2 = omega * omega;
+    let mut out = Mat::<f64>::zeros(4 * model.n_isolines(), 3);
+    for (v, t) in handles.constrained().zip(targets.positions()) {
+        for (p, value) in model.position_row(v as usize) {
+            for a in 0..3 {
+                out[(p, a)] += w2 * value * t[a];
+            }
+        }
+    }
+    out
+}
+
+/// The matrices of eq 10 for one handle set; see the module docs.
+pub struct ReducedSystem {
+    /// `U^T U`, `4N x 4N`.
+    pub normal_matrix: Mat<f64>,
+    /// `W_x^T L^T W_delta`, `4N x 3N` (empty when `delta` is evaluated on the mesh, the `t_1` variant).
+    pub laplacian_rhs: Mat<f64>,
+    omega: f64,
+}
+
+impl ReducedSystem {
+    /// Build `U^T U = W_x^T L^T L W_x + omega^2 W_x^T Phi^T Phi W_x + beta^2 M^T M` and, when
+    /// `interpolate_delta`, `W_x^T L^T W_delta`; also sets the model's `delta_bar = L X_base`.
+    /// `laplacian`: the `#V x #V` cotangent Laplacian (symmetric).
+    pub fn new(
+        model: &mut IsolineModel,
+        laplacian: SparseColMatRef<'_, usize, f64>,
+        handles: &HandleSet,
+        omega: f64,
+        beta: f64,
+        interpolate_delta: bool,
+    ) -> Self {
+        let independent = HandleIndependentSystem::new(model, laplacian, beta, interpolate_delta);
+        let normal_matrix = independent.constrained_normal_matrix(model, handles, omega);
+        Self { normal_matrix, laplacian_rhs: independent.laplacian_rhs, omega }
     }
 
     /// `omega^2 W_x^T Phi^T H` (`4N x 3`) for the targets `H` of the constrained vertices.
@@ -397,16 +615,7 @@ impl ReducedSystem {
         handles: &HandleSet,
         targets: &HandleTargets,
     ) -> Mat<f64> {
-        let w2 = self.omega * self.omega;
-        let mut out = Mat::<f64>::zeros(4 * model.n_isolines(), 3);
-        for (v, t) in handles.constrained().zip(targets.positions()) {
-            for (p, value) in model.position_row(v as usize) {
-                for a in 0..3 {
-                    out[(p, a)] += w2 * value * t[a];
-                }
-            }
-        }
-        out
+        constraint_rhs(model, handles, targets, self.omega)
     }
 
     /// `W_x^T L^T delta` (`4N x 3`) for `delta` evaluated on the mesh (`#V x 3`; the `t_1` variant).

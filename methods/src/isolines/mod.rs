@@ -52,7 +52,9 @@ use meshes::{Topology, TriMesh};
 use serde::Deserialize;
 
 pub use harmonic_fields::harmonic_fields;
-pub use interpolation::{IsolineModel, ReducedSystem};
+pub use interpolation::{
+    constraint_rhs, HandleIndependentSystem, IsolineModel, ReducedSystem, RotationFit, SetBlend,
+};
 
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
@@ -212,10 +214,13 @@ impl DeformationMethod for Isolines {
         let t0 = Instant::now();
         let fields = harmonic_fields(rest.laplacian.as_ref(), handles)?;
         let t1 = Instant::now();
+        // Two handles: one set on the first field (the second is its complement).
+        let sets = if fields.ncols() == 2 { fields.as_ref().subcols(0, 1) } else { fields.as_ref() };
         let mut model = IsolineModel::new(
             &self.current,
             &rest.triangles,
-            fields.as_ref(),
+            sets,
+            &SetBlend::FieldValues,
             self.params.isolines,
             self.params.max_crossed_triangles,
         );
@@ -274,7 +279,7 @@ impl DeformationMethod for Isolines {
             let mut rhs = constraint_rhs.clone();
             match &mut bound.coordinates {
                 None => {
-                    let rotations = bound.model.isoline_rotations(&probes);
+                    let rotations = bound.model.isoline_rotations(&probes, RotationFit::SegmentFrames);
                     rhs += &bound.system.laplacian_rhs * &rotations;
                 }
                 Some(coordinates) => {
@@ -327,6 +332,12 @@ impl DeformationMethod for Isolines {
 
     fn phase_timings(&self) -> Vec<(&'static str, f64)> {
         self.timings.clone()
+    }
+
+    fn model_statistics(&self) -> Vec<(&'static str, f64)> {
+        self.bound.as_ref().map_or_else(Vec::new, |b| {
+            vec![("n_isolines", b.model.n_isolines() as f64), ("n_tri", b.model.n_sampled_triangles() as f64)]
+        })
     }
 }
 

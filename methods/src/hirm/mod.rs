@@ -1,0 +1,337 @@
+//! `hirm`: the handle-independent reduced model for incremental mesh editing (Wu, Au, Tai & Lu
+//! 2015).
+//!
+//! Section 4.1: propagation fields, the first eigenvectors of the rest mesh's Laplacian with score
+//! `S_i < phi` ([`propagation_fields`]). Sections 4.2–4.3: `n_iso` isolines per field carry 3x4
+//! transforms `r_ij`; `X = W R` interpolates them linearly along each field (eq 4–5) and blends the
+//! fields by the normalized spectral importances `omega_bar_i` (eq 7–8), so `W` does not depend on
+//! the handles. Section 4.4: iterative Laplacian editing in the reduced domain,
+//! `R = (U^T U)^{-1} [W^T L^T W_sigma R_sigma(X) + omega^2 W^T Phi^T H]` (eq 20), with `R_sigma` the
+//! isoline rotations of eq 17–19 fitted to the sampled crossed triangles only, so per-iteration work
+//! does not depend on `#V`. Section 4.5: after each solve a worker thread recomputes the
+//! handle-independent `T_1`, `T_2` (eq 22–25) on the current shape ([`background`]); binding a new
+//! handle set only adds `(Phi W)^T (Phi W)` and factors the `4N x 4N` matrix (eq 26–28).
+//!
+//! The isoline machinery (tracing, two-level interpolation, the reduced matrices) is shared with
+//! [`crate::isolines`]; what differs is where the fields come from, how they are blended
+//! ([`SetBlend::PerSet`]) and how isoline rotations are fitted ([`RotationFit::ScaledOrthogonal`]).
+//!
+//! Decisions the paper leaves open:
+//! - The eigenvectors of the *rest* shape are kept throughout (section 4.5); `W(X)` and the
+//!   Laplacian coordinates `sigma(X) = L X` of the base are rebuilt on the current shape, with `L`
+//!   the rest mesh's cotangent Laplacian.
+//! - Soft constraints `omega^2 |Phi W R - H|^2` on every handle vertex, `omega = 1000` as in
+//!   `laplacian` and `isolines` (the paper gives no weight).
+//! - `bind_handles` waits for a background precompute still running; the wait is reported
+//!   separately (`bind_background_wait`) from the handle update `t_h`.
+//! - The step size is the largest displacement of the vertices of the sampled triangles.
+
+pub mod background;
+pub mod propagation_fields;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use faer::linalg::solvers::{Llt, SolveCore};
+use faer::{Mat, Side};
+use meshes::{Topology, TriMesh};
+use serde::Deserialize;
+
+pub use background::{handle_independent_model, BackgroundPrecompute, HandleIndependentModel, SystemInputs};
+pub use propagation_fields::{propagation_fields, select_fields, PropagationFields};
+
+use crate::error::MethodError;
+use crate::handles::{HandleSet, HandleTargets};
+use crate::isolines::{constraint_rhs, RotationFit};
+use crate::method::{DeformationMethod, IterationObserver, IterationReport, SolveSummary};
+use crate::operators::cotan_laplacian;
+
+/// Parameters of [`Hirm`] (configs/methods.toml, section `[hirm]`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct HirmParams {
+    /// `phi` of eq 1: fields with `sqrt(lambda_i / lambda_2) < phi` are selected (the paper: 3.5).
+    pub threshold: f64,
+    /// Upper bound on the number of fields (the paper's meshes select 3 to 14).
+    pub max_fields: usize,
+    /// `n_iso`, isolines per field (the paper: 20).
+    pub isolines: usize,
+    /// Upper bound on the sampled crossed triangles of all isolines (the paper's Table 1 `n_t1`:
+    /// 600 to 3000).
+    pub max_crossed_triangles: usize,
+    /// `mu` of the smoothness term (eq 11; the paper: 0.01).
+    pub mu: f64,
+    /// Soft handle-constraint weight `omega`.
+    pub omega: f64,
+    /// Iteration limit per solve.
+    pub max_iterations: usize,
+    /// Converged when the step falls below `tolerance x bbox diagonal`.
+    pub tolerance: f64,
+    /// Seed of the eigensolver's start vectors.
+    pub seed: u64,
+}
+
+impl Default for HirmParams {
+    fn default() -> Self {
+        Self {
+            threshold: 3.5,
+            max_fields: 20,
+            isolines: 20,
+            max_crossed_triangles: 1200,
+            mu: 0.01,
+            omega: 1000.0,
+            max_iterations: 500,
+            tolerance: 1e-5,
+            seed: 0x5eed,
+        }
+    }
+}
+
+/// Rest-mesh data kept for the whole edit session.
+struct Rest {
+    inputs: Arc<SystemInputs>,
+    scores: Vec<f64>,
+    capped: bool,
+    bbox_diagonal: f64,
+}
+
+/// The handle-independent system of the current shape: ready, or being computed.
+enum Precomputed {
+    Ready(Arc<HandleIndependentModel>),
+    Running(BackgroundPrecompute),
+}
+
+/// Everything `bind_handles` adds for one handle set.
+struct Bound {
+    independent: Arc<HandleIndependentModel>,
+    factor: Llt<f64>,
+    handles: HandleSet,
+}
+
+/// The HIRM reduced model; see the module documentation.
+pub struct Hirm {
+    params: HirmParams,
+    rest: Option<Rest>,
+    precomputed: Option<Precomputed>,
+    bound: Option<Bound>,
+    /// `#V x 3` shape at the last bind or solve.
+    current: Vec<[f64; 3]>,
+    /// `4N x 3` reduced variables of the current solve.
+    reduced: Mat<f64>,
+    timings: Vec<(&'static str, f64)>,
+}
+
+impl Hirm {
+    /// A method with the given parameters.
+    pub fn new(params: HirmParams) -> Result<Self, MethodError> {
+        if !(params.threshold > 1.0)
+            || params.max_fields == 0
+            || params.isolines < 2
+            || params.max_crossed_triangles == 0
+            || !(params.mu >= 0.0)
+            || !(params.omega > 0.0)
+            || params.max_iterations == 0
+            || !(params.tolerance >= 0.0)
+        {
+            return Err(MethodError::Parameters {
+                method: "hirm",
+                message:
+                    "threshold must be > 1, max_fields >= 1, isolines >= 2, max_crossed_triangles >= 1, \
+                          mu >= 0, omega > 0, max_iterations >= 1, tolerance >= 0"
+                        .into(),
+            });
+        }
+        Ok(Self {
+            params,
+            rest: None,
+            precomputed: None,
+            bound: None,
+            current: Vec::new(),
+            reduced: Mat::zeros(0, 3),
+            timings: Vec::new(),
+        })
+    }
+
+    /// `S_i` of the selected propagation fields (their number is `n_field`).
+    pub fn field_scores(&self) -> Option<&[f64]> {
+        self.rest.as_ref().map(|r| r.scores.as_slice())
+    }
+
+    /// What the handle-independent system is built from (after `precompute`).
+    pub fn system_inputs(&self) -> Option<Arc<SystemInputs>> {
+        self.rest.as_ref().map(|r| r.inputs.clone())
+    }
+
+    /// The handle-independent model of the bound handle set (for tests and reports).
+    pub fn bound_model(&self) -> Option<&HandleIndependentModel> {
+        self.bound.as_ref().map(|b| b.independent.as_ref())
+    }
+
+    /// Wait for a background precompute still running and return the current handle-independent
+    /// model (for tests: compare with [`handle_independent_model`] on [`Self::positions`]).
+    pub fn handle_independent(&mut self) -> Result<Option<Arc<HandleIndependentModel>>, MethodError> {
+        let ready = match self.precomputed.take() {
+            None => return Ok(None),
+            Some(Precomputed::Ready(m)) => m,
+            Some(Precomputed::Running(worker)) => {
+                let model = Arc::new(worker.finish()?);
+                self.set_timing("t_b_background_precompute", model.seconds);
+                model
+            }
+        };
+        self.precomputed = Some(Precomputed::Ready(ready.clone()));
+        Ok(Some(ready))
+    }
+
+    fn set_timing(&mut self, name: &'static str, seconds: f64) {
+        self.timings.retain(|(k, _)| *k != name);
+        self.timings.push((name, seconds));
+    }
+}
+
+impl DeformationMethod for Hirm {
+    fn name(&self) -> &'static str {
+        "hirm"
+    }
+
+    fn precompute(&mut self, rest: &TriMesh) -> Result<(), MethodError> {
+        Topology::new(rest)?;
+        self.timings.clear();
+        self.bound = None;
+        // Drop (join) any worker of a previous mesh before starting over.
+        if let Some(Precomputed::Running(worker)) = self.precomputed.take() {
+            worker.finish()?;
+        }
+        let start = Instant::now();
+        let fields = propagation_fields(
+            rest.positions(),
+            rest.triangles(),
+            self.params.threshold,
+            self.params.max_fields,
+            self.params.seed,
+        )?;
+        self.set_timing("t_e_propagation_fields", start.elapsed().as_secs_f64());
+        let inputs = Arc::new(SystemInputs {
+            triangles: rest.triangles().to_vec(),
+            fields: fields.fields,
+            weights: fields.weights,
+            laplacian: cotan_laplacian(rest.positions(), rest.triangles()),
+            isolines: self.params.isolines,
+            max_crossed_triangles: self.params.max_crossed_triangles,
+            mu: self.params.mu,
+        });
+        // The rest shape's system, synchronously: nothing to hide it behind yet.
+        let model = handle_independent_model(rest.positions(), &inputs);
+        self.set_timing("t_b_background_precompute", model.seconds);
+        self.precomputed = Some(Precomputed::Ready(Arc::new(model)));
+        self.rest = Some(Rest {
+            inputs,
+            scores: fields.scores,
+            capped: fields.capped,
+            bbox_diagonal: rest.bbox_diagonal(),
+        });
+        self.current = rest.positions().to_vec();
+        Ok(())
+    }
+
+    fn bind_handles(&mut self, handles: &HandleSet) -> Result<(), MethodError> {
+        if self.rest.is_none() {
+            return Err(MethodError::Phase { method: "hirm", phase: "bind_handles", missing: "precompute" });
+        }
+        handles.check_mesh_size(self.current.len())?;
+        let wait = Instant::now();
+        let independent = self.handle_independent()?.expect("precompute leaves a model or a worker");
+        self.set_timing("bind_background_wait", wait.elapsed().as_secs_f64());
+        // t_h: eq 26 and the factorization of U^T U.
+        let start = Instant::now();
+        let normal =
+            independent.system.constrained_normal_matrix(&independent.model, handles, self.params.omega);
+        let factor = normal
+            .as_ref()
+            .llt(Side::Lower)
+            .map_err(|_| MethodError::Solver(crate::sparse_cholesky::SolverError::NotPositiveDefinite))?;
+        self.set_timing("t_h_handle_update", start.elapsed().as_secs_f64());
+        self.reduced = independent.model.identity_transforms();
+        self.bound = Some(Bound { independent, factor, handles: handles.clone() });
+        Ok(())
+    }
+
+    fn solve(
+        &mut self,
+        targets: &HandleTargets,
+        observer: &mut dyn IterationObserver,
+    ) -> Result<SolveSummary, MethodError> {
+        let (Some(rest), Some(bound)) = (&self.rest, &self.bound) else {
+            return Err(MethodError::Phase { method: "hirm", phase: "solve", missing: "bind_handles" });
+        };
+        let (model, system) = (&bound.independent.model, &bound.independent.system);
+        let t0 = Instant::now();
+        // omega^2 W^T Phi^T H of eq 27, once per solve.
+        let constraints = constraint_rhs(model, &bound.handles, targets, self.params.omega);
+        let mut probes = model.probe_positions(self.reduced.as_ref());
+        let mut summary = SolveSummary { iterations: 0, converged: false, final_step: f64::INFINITY };
+        let setup = t0.elapsed().as_secs_f64();
+        for iteration in 0..self.params.max_iterations {
+            let start = Instant::now();
+            // Eq 17–19, then eq 20 (eq 27 with T_2 = W^T L^T W_sigma R_sigma).
+            let rotations = model.isoline_rotations(&probes, RotationFit::ScaledOrthogonal);
+            let mut rhs = &system.laplacian_rhs * &rotations;
+            rhs += &constraints;
+            bound.factor.solve_in_place_with_conj(faer::Conj::No, rhs.as_mut());
+            self.reduced = rhs;
+            let next = model.probe_positions(self.reduced.as_ref());
+            if let Some(i) = next.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+                let vertex = model.probe_vertex(i) as usize;
+                return Err(MethodError::NonFinite { method: "hirm", vertex, iteration });
+            }
+            let step = crate::method::max_displacement(&probes, &next) / rest.bbox_diagonal;
+            probes = next;
+            let report = IterationReport { iteration, step, seconds: start.elapsed().as_secs_f64() };
+            summary = SolveSummary {
+                iterations: iteration + 1,
+                converged: step < self.params.tolerance,
+                final_step: step,
+            };
+            let reduced = &self.reduced;
+            let flow = observer.on_iteration(&report, &|| model.positions(reduced.as_ref()));
+            if summary.converged || flow.is_break() {
+                break;
+            }
+        }
+        // Eq 21 / 28 for every vertex, once.
+        let t1 = Instant::now();
+        let current = model.positions(self.reduced.as_ref());
+        if let Some(i) = current.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(MethodError::NonFinite { method: "hirm", vertex: i, iteration: summary.iterations });
+        }
+        let positions_seconds = t1.elapsed().as_secs_f64();
+        // Section 4.5: the next handle set's T_1, T_2 are computed on this shape in the background.
+        let worker = BackgroundPrecompute::start(current.clone(), rest.inputs.clone());
+        self.current = current;
+        self.precomputed = Some(Precomputed::Running(worker));
+        self.set_timing("solve_constraint_rhs", setup);
+        self.set_timing("solve_vertex_positions", positions_seconds);
+        Ok(summary)
+    }
+
+    fn positions(&self) -> Vec<[f64; 3]> {
+        self.current.clone()
+    }
+
+    fn phase_timings(&self) -> Vec<(&'static str, f64)> {
+        self.timings.clone()
+    }
+
+    fn model_statistics(&self) -> Vec<(&'static str, f64)> {
+        let mut out = Vec::new();
+        if let Some(rest) = &self.rest {
+            out.push(("n_field", rest.scores.len() as f64));
+            out.push(("n_iso", self.params.isolines as f64));
+            out.push(("fields_capped", f64::from(u8::from(rest.capped))));
+        }
+        if let Some(bound) = &self.bound {
+            out.push(("n_t", bound.independent.model.n_sampled_triangles() as f64));
+        }
+        out
+    }
+}

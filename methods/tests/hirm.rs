@@ -1,0 +1,200 @@
+//! Properties of `hirm` (Wu et al. 2015): the field selection rule (eq 1–2) on a mesh with a known
+//! spectrum, the handle-independent interpolation (identity transforms reproduce the base shape), the
+//! background precompute (same matrices as a synchronous one), incremental binding (a new handle set
+//! starts from the current shape, which is a fixed point), and clear errors.
+
+use meshes::shapes::{generate, ShapeKind};
+use meshes::{TriMesh, VertexStatus};
+use methods::hirm::{handle_independent_model, propagation_fields, select_fields, Hirm, HirmParams};
+use methods::{DeformationMethod, HandleRegion, HandleSet, HandleTargets, MethodError, NoObserver};
+
+/// Tolerance of the fixed-point tests, relative to the bounding-box diagonal (see
+/// `rest_shape_is_a_fixed_point`).
+const FIXED_POINT: f64 = 2e-6;
+
+/// A flat `length x 1` strip, `cells` quads along and `cells / length` across, two triangles each.
+fn strip(length: f64, cells: usize) -> TriMesh {
+    let across = (cells as f64 / length).round() as usize;
+    let (nx, ny) = (cells + 1, across + 1);
+    let positions = (0..ny).flat_map(|j| {
+        (0..nx).map(move |i| [length * i as f64 / cells as f64, j as f64 / across as f64, 0.0])
+    });
+    let id = |i: usize, j: usize| (j * nx + i) as u32;
+    let triangles = (0..across)
+        .flat_map(|j| {
+            (0..cells).flat_map(move |i| {
+                [[id(i, j), id(i + 1, j), id(i + 1, j + 1)], [id(i, j), id(i + 1, j + 1), id(i, j + 1)]]
+            })
+        })
+        .collect();
+    TriMesh::new(positions.collect(), triangles).unwrap()
+}
+
+/// Procedural bar (~2K vertices) with its fixed and handle regions.
+fn bar() -> (TriMesh, HandleSet) {
+    let shape = generate(ShapeKind::Bar, 2000).unwrap();
+    let region = |name: &str, status| HandleRegion {
+        name: name.into(),
+        vertices: meshes::edit::vertices_with_status(&shape.selection, status),
+    };
+    let regions = vec![region("fixed", VertexStatus::Fixed), region("handle", VertexStatus::Handle)];
+    let handles = HandleSet::new(regions, shape.mesh.n_vertices()).unwrap();
+    (shape.mesh, handles)
+}
+
+/// Targets: `fixed` where it is in `current`, `handle` moved by `offset`.
+fn targets(handles: &HandleSet, current: &[[f64; 3]], offset: [f64; 3]) -> HandleTargets {
+    let mut out = Vec::new();
+    for region in handles.regions() {
+        let d = if region.name == "handle" { offset } else { [0.0; 3] };
+        out.extend(region.vertices.iter().map(|&v| {
+            let p = current[v as usize];
+            [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
+        }));
+    }
+    HandleTargets::new(handles, out).unwrap()
+}
+
+#[test]
+fn selection_rule_counts_scores_below_the_threshold() {
+    // S_i = sqrt(lambda_i / lambda_2) = 1, 2, 3, 4.
+    let values = [0.0, 1.0, 4.0, 9.0, 16.0];
+    assert_eq!(select_fields(&values, 3.5), Some(3));
+    assert_eq!(select_fields(&values, 2.0), Some(1));
+    assert_eq!(select_fields(&values, 4.0), Some(3), "S_i < phi is strict");
+    assert_eq!(select_fields(&values, 10.0), Some(4));
+    assert_eq!(select_fields(&[0.0, 0.0, 1.0], 3.5), None, "lambda_2 = 0: disconnected");
+}
+
+#[test]
+fn strip_selects_its_three_longitudinal_modes() {
+    // Neumann modes of a 10 x 1 strip: lambda = pi^2 (m^2 / 100 + n^2). With n = 0 the scores are
+    // m = 1, 2, 3, 4, ...; the first transverse mode scores 10. phi = 3.5 keeps m = 1, 2, 3.
+    let mesh = strip(10.0, 100);
+    let fields = propagation_fields(mesh.positions(), mesh.triangles(), 3.5, 20, 7).unwrap();
+    assert_eq!(fields.scores.len(), 3, "scores {:?}", fields.scores);
+    for (m, s) in fields.scores.iter().enumerate() {
+        assert!((s - (m + 1) as f64).abs() < 0.02 * (m + 1) as f64, "score {s} of mode {}", m + 1);
+    }
+    assert!(!fields.capped);
+    for i in 0..3 {
+        let col: Vec<f64> = (0..mesh.n_vertices()).map(|k| fields.fields[(k, i)]).collect();
+        let (lo, hi) = col.iter().fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+        assert!(lo.abs() < 1e-12 && (hi - 1.0).abs() < 1e-12, "field {i} spans [{lo}, {hi}]");
+    }
+    let total: f64 = fields.weights.iter().sum();
+    assert!((total - 1.0).abs() < 1e-12 && fields.weights.iter().all(|w| *w >= 0.0));
+    // The strip lies along x: the first (half-cosine) mode carries most of the geometry.
+    assert!(
+        fields.weights[0] > fields.weights[1] && fields.weights[0] > fields.weights[2],
+        "{:?}",
+        fields.weights
+    );
+}
+
+#[test]
+fn identity_transforms_reproduce_the_base_shape() {
+    let (mesh, _) = bar();
+    let mut hirm = Hirm::new(HirmParams::default()).unwrap();
+    hirm.precompute(&mesh).unwrap();
+    let inputs = hirm.system_inputs().unwrap();
+    // A base shape other than the rest mesh: W = W(X) interpolates whatever it is built on.
+    let base: Vec<[f64; 3]> =
+        mesh.positions().iter().map(|p| [p[0] + 0.1 * p[2], 1.5 * p[1], p[2]]).collect();
+    let built = handle_independent_model(&base, &inputs);
+    let reproduced = built.model.positions(built.model.identity_transforms().as_ref());
+    let error = methods::method::max_displacement(&reproduced, &base);
+    assert!(error < 1e-12 * mesh.bbox_diagonal(), "W R_identity differs from X by {error}");
+    // Every vertex's weights sum to 1 (eq 8 with normalized omega_bar).
+    for k in 0..mesh.n_vertices() {
+        let s: f64 = built.model.vertex_weights(k).iter().map(|(_, w)| w).sum();
+        assert!((s - 1.0).abs() < 1e-12, "vertex {k}: weights sum to {s}");
+    }
+}
+
+#[test]
+fn background_precompute_gives_the_synchronous_matrices() {
+    let (mesh, handles) = bar();
+    let mut hirm = Hirm::new(HirmParams::default()).unwrap();
+    hirm.precompute(&mesh).unwrap();
+    hirm.bind_handles(&handles).unwrap();
+    let diagonal = mesh.bbox_diagonal();
+    hirm.solve(&targets(&handles, mesh.positions(), [0.0, 0.1 * diagonal, 0.0]), &mut NoObserver).unwrap();
+    // The solve started a worker on the deformed shape; compare its result with a synchronous build.
+    let background = hirm.handle_independent().unwrap().unwrap();
+    let synchronous = handle_independent_model(&hirm.positions(), &hirm.system_inputs().unwrap());
+    assert_ne!(hirm.positions(), mesh.positions().to_vec(), "the solve moved the mesh");
+    assert_eq!(background.system.smoothness_normal_matrix, synchronous.system.smoothness_normal_matrix);
+    assert_eq!(background.system.laplacian_rhs, synchronous.system.laplacian_rhs);
+    assert_eq!(background.model.base_delta(), synchronous.model.base_delta());
+}
+
+#[test]
+fn rest_shape_is_a_fixed_point() {
+    let (mesh, handles) = bar();
+    let mut hirm = Hirm::new(HirmParams::default()).unwrap();
+    hirm.precompute(&mesh).unwrap();
+    hirm.bind_handles(&handles).unwrap();
+    let summary = hirm.solve(&targets(&handles, mesh.positions(), [0.0; 3]), &mut NoObserver).unwrap();
+    let moved = methods::method::max_displacement(&hirm.positions(), mesh.positions());
+    // Exact in exact arithmetic; U^T U couples omega^2 = 1e6 constraints with mu^2 = 1e-4
+    // smoothness, and its factorization leaves ~1e-7 of the diagonal (isolines: 1e-10).
+    assert!(moved < FIXED_POINT * mesh.bbox_diagonal(), "rest shape moved by {moved}");
+    assert!(summary.converged && summary.iterations <= 2, "{summary:?}");
+}
+
+#[test]
+fn second_handle_set_starts_from_the_current_shape() {
+    let (mesh, handles) = bar();
+    let diagonal = mesh.bbox_diagonal();
+    let mut hirm = Hirm::new(HirmParams::default()).unwrap();
+    hirm.precompute(&mesh).unwrap();
+    hirm.bind_handles(&handles).unwrap();
+    hirm.solve(&targets(&handles, mesh.positions(), [0.15 * diagonal, 0.0, 0.0]), &mut NoObserver).unwrap();
+    let first = hirm.positions();
+    assert!(methods::method::max_displacement(&first, mesh.positions()) > 0.1 * diagonal);
+
+    // Add a third handle: the free vertices nearest the middle of the bent bar.
+    let middle_point = first.iter().fold([0.0; 3], |a, p| [a[0] + p[0], a[1] + p[1], a[2] + p[2]]);
+    let middle_point = middle_point.map(|c| c / first.len() as f64);
+    let mut free: Vec<u32> =
+        (0..mesh.n_vertices() as u32).filter(|&v| handles.region_of()[v as usize] == u32::MAX).collect();
+    let distance = |v: &u32| methods::method::max_displacement(&[first[*v as usize]], &[middle_point]);
+    free.sort_by(|a, b| distance(a).total_cmp(&distance(b)));
+    let mut regions = handles.regions().to_vec();
+    regions.push(HandleRegion { name: "middle".into(), vertices: free[..20].to_vec() });
+    let second = HandleSet::new(regions, mesh.n_vertices()).unwrap();
+    hirm.bind_handles(&second).unwrap();
+
+    // Bound on the current shape: W R_identity is the first result, not the rest mesh.
+    assert_eq!(hirm.positions(), first);
+    let model = &hirm.bound_model().unwrap().model;
+    let base = model.positions(model.identity_transforms().as_ref());
+    assert!(methods::method::max_displacement(&base, &first) < 1e-12 * diagonal);
+    // Holding every handle where it is keeps the shape: it is the new system's fixed point.
+    hirm.solve(&targets(&second, &first, [0.0; 3]), &mut NoObserver).unwrap();
+    let moved = methods::method::max_displacement(&hirm.positions(), &first);
+    assert!(moved < FIXED_POINT * diagonal, "held shape moved by {moved}");
+}
+
+#[test]
+fn bad_parameters_and_phases_are_errors() {
+    let bad = [
+        HirmParams { threshold: 1.0, ..HirmParams::default() },
+        HirmParams { max_fields: 0, ..HirmParams::default() },
+        HirmParams { isolines: 1, ..HirmParams::default() },
+        HirmParams { mu: f64::NAN, ..HirmParams::default() },
+        HirmParams { omega: 0.0, ..HirmParams::default() },
+    ];
+    for params in bad {
+        assert!(matches!(Hirm::new(params), Err(MethodError::Parameters { .. })));
+    }
+    let (mesh, handles) = bar();
+    let mut hirm = Hirm::new(HirmParams::default()).unwrap();
+    assert!(matches!(hirm.bind_handles(&handles), Err(MethodError::Phase { .. })));
+    hirm.precompute(&mesh).unwrap();
+    let t = targets(&handles, mesh.positions(), [0.0; 3]);
+    assert!(matches!(hirm.solve(&t, &mut NoObserver), Err(MethodError::Phase { .. })));
+    let small = HandleSet::new(vec![HandleRegion { name: "h".into(), vertices: vec![0] }], 10).unwrap();
+    assert!(hirm.bind_handles(&small).is_err(), "a handle set for another mesh size");
+}
