@@ -92,6 +92,52 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
     let cases = json["cases"].as_array().unwrap();
     assert_eq!(cases.len(), rows.len());
     assert!(cases.iter().all(|c| !c["trace"].as_array().unwrap().is_empty()));
+
+    // Incremental editing (HIRM section 4.5): every method runs both steps; the second adds a handle.
+    let updates = csv_rows(&reports.path().join("handle_updates.csv"));
+    for scenario in ["bar-incremental", "cactus-incremental"] {
+        for method in methods::registry::method_names() {
+            let row = rows.iter().find(|r| r["scenario"] == scenario && r["method"] == method).unwrap();
+            assert_eq!(row["status"], "ok", "{scenario}/{method}");
+            let steps: Vec<_> =
+                updates.iter().filter(|u| u["scenario"] == scenario && u["method"] == method).collect();
+            let handles: Vec<&str> = steps.iter().map(|u| u["handles"].as_str()).collect();
+            assert_eq!(handles, ["2", "3"], "{scenario}/{method}");
+            assert!(steps.iter().all(|u| num(u, "bind_ms") >= 0.0));
+        }
+    }
+    // HIRM's Table 1: 2, 6 and 10 handles on the bar and the cactus, with the field count.
+    let table1 = std::fs::read_to_string(reports.path().join("table1.md")).unwrap();
+    for scenario in ["bar-handles", "cactus-handles"] {
+        for n_h in ["2", "6", "10"] {
+            let row = updates
+                .iter()
+                .find(|u| u["scenario"] == scenario && u["method"] == "hirm" && u["handles"] == n_h);
+            let row = row.unwrap_or_else(|| panic!("{scenario}: no hirm step with {n_h} handles"));
+            assert!(num(row, "t_h_ms") > 0.0 && num(row, "t_h_ms") <= num(row, "bind_ms"));
+        }
+        assert_eq!(
+            table1.lines().filter(|l| l.starts_with(&format!("| {scenario} |"))).count(),
+            3,
+            "{table1}"
+        );
+    }
+    let hirm_fields = cases
+        .iter()
+        .filter(|c| c["method"] == "hirm")
+        .map(|c| {
+            c["statistics"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|s| s[0] == "n_field")
+                .map(|s| s[1].as_f64().unwrap())
+        })
+        .collect::<Vec<_>>();
+    assert!(
+        !hirm_fields.is_empty() && hirm_fields.iter().all(|n| n.is_some_and(|n| n >= 1.0)),
+        "{hirm_fields:?}"
+    );
 }
 
 #[test]

@@ -17,6 +17,24 @@ pub struct IterationRecord {
     pub seconds: f64,
 }
 
+/// One edit step of a case: a handle set bound and solved for.
+#[derive(Clone, Debug, Serialize)]
+pub struct StepRecord {
+    /// 1-based.
+    pub step: usize,
+    /// Handle regions (the fixed region counts as one, as in HIRM's Table 1).
+    pub handles: usize,
+    pub constrained_vertices: usize,
+    /// Wall time of `bind_handles`: the handle-set update a user waits for.
+    pub bind_s: f64,
+    pub solve_s: f64,
+    pub iterations: usize,
+    pub converged: bool,
+    pub median_iteration_ms: f64,
+    /// The method's phase timings after this step (e.g. HIRM's `t_h_handle_update`).
+    pub phase_timings: Vec<(String, f64)>,
+}
+
 /// Measurements of one case. Times are wall-clock seconds; the `*_over_diag` values are relative to
 /// the rest bounding-box diagonal; angle errors are in degrees.
 #[derive(Clone, Debug, Serialize)]
@@ -40,8 +58,14 @@ pub struct CaseResult {
     pub rms_to_arap_over_diag: Option<f64>,
     /// `ok`, or `failed: <reason>`.
     pub status: String,
-    /// Method-specific phases (e.g. HIRM's t_e, t_b) in seconds.
+    /// Method-specific phases (e.g. HIRM's t_e, t_b) in seconds, after the last step.
     pub phase_timings: Vec<(String, f64)>,
+    /// Sizes of a reduced model (e.g. HIRM's `n_field`), after the last step.
+    pub statistics: Vec<(String, f64)>,
+    /// Every edit step (one for a single edit); the top-level bind, solve and iteration figures
+    /// are the first step's bind and the sums and median over all steps.
+    pub steps: Vec<StepRecord>,
+    /// Iterations of all steps, in order.
     pub trace: Vec<IterationRecord>,
     #[serde(skip)]
     pub positions: Option<Vec<[f64; 3]>>,
@@ -83,6 +107,8 @@ pub fn run_case(
         rms_to_arap_over_diag: None,
         status: String::new(),
         phase_timings: Vec::new(),
+        statistics: Vec::new(),
+        steps: Vec::new(),
         trace: Vec::new(),
         positions: None,
     };
@@ -92,42 +118,67 @@ pub fn run_case(
         let start = Instant::now();
         m.precompute(&scenario.mesh)?;
         result.precompute_s = start.elapsed().as_secs_f64();
-        let t = Instant::now();
-        m.bind_handles(&scenario.handles)?;
-        result.bind_s = t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let summary = m.solve(&scenario.targets, &mut recorder)?;
+        let mut solve_s = 0.0;
+        let mut final_edit = None;
+        for (i, step) in scenario.steps.iter().enumerate() {
+            let targets = step.targets(&m.positions())?;
+            let t = Instant::now();
+            m.bind_handles(&step.handles)?;
+            let bind_s = t.elapsed().as_secs_f64();
+            let first_iteration = recorder.0.len();
+            let t = Instant::now();
+            let summary = m.solve(&targets, &mut recorder)?;
+            let step_solve_s = t.elapsed().as_secs_f64();
+            solve_s += step_solve_s;
+            result.iterations += summary.iterations;
+            result.converged = summary.converged && (i == 0 || result.converged);
+            result.steps.push(StepRecord {
+                step: i + 1,
+                handles: step.handles.regions().len(),
+                constrained_vertices: step.handles.n_constrained(),
+                bind_s,
+                solve_s: step_solve_s,
+                iterations: summary.iterations,
+                converged: summary.converged,
+                median_iteration_ms: median_ms(&recorder.0[first_iteration..]),
+                phase_timings: m.phase_timings().into_iter().map(|(k, v)| (k.to_string(), v)).collect(),
+            });
+            final_edit = Some((step, targets, summary.iterations));
+        }
         let positions = m.positions();
-        result.solve_s = t.elapsed().as_secs_f64();
+        result.bind_s = result.steps.first().map_or(f64::NAN, |s| s.bind_s);
+        result.solve_s = solve_s;
         result.total_s = start.elapsed().as_secs_f64();
-        result.iterations = summary.iterations;
-        result.converged = summary.converged;
         result.phase_timings = m.phase_timings().into_iter().map(|(k, v)| (k.to_string(), v)).collect();
+        result.statistics = m.model_statistics().into_iter().map(|(k, v)| (k.to_string(), v)).collect();
+        let (step, targets, _) = final_edit.expect("a scenario has at least one step");
         if let Some(v) = positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
             return Err(methods::MethodError::NonFinite {
                 method: m.name(),
                 vertex: v,
-                iteration: summary.iterations,
+                iteration: result.iterations,
             });
         }
         let diagonal = scenario.mesh.bbox_diagonal();
         let (e_theta, e_phi) = angle_errors(rest_angles, &scenario.mesh, &scenario.topology, &positions);
         result.e_theta_deg = e_theta;
         result.e_phi_deg = e_phi;
-        result.handle_residual_over_diag =
-            handle_residual(&scenario.handles, &scenario.targets, &positions, diagonal);
+        result.handle_residual_over_diag = handle_residual(&step.handles, &targets, &positions, diagonal);
         result.positions = Some(positions);
         Ok(())
     })();
+    result.median_iteration_ms = median_ms(&recorder.0);
     result.trace = recorder.0;
-    if !result.trace.is_empty() {
-        let mut times: Vec<f64> = result.trace.iter().map(|r| r.seconds).collect();
-        times.sort_by(f64::total_cmp);
-        result.median_iteration_ms = 1e3 * times[times.len() / 2];
-    }
     result.status = match outcome {
         Ok(()) => "ok".into(),
         Err(e) => format!("failed: {e}"),
     };
     result
+}
+
+/// Median iteration time in milliseconds (NaN for none).
+fn median_ms(trace: &[IterationRecord]) -> f64 {
+    let mut times: Vec<f64> = trace.iter().map(|r| r.seconds).collect();
+    times.sort_by(f64::total_cmp);
+    times.get(times.len() / 2).map_or(f64::NAN, |t| 1e3 * t)
 }

@@ -82,6 +82,98 @@ pub fn render_json(results: &[CaseResult], data_source: &str) -> Result<Vec<u8>,
     serde_json::to_vec_pretty(&report).map_err(|e| HarnessError::Report(format!("JSON: {e}")))
 }
 
+/// Columns of `handle_updates.csv`: one row per (scenario, method, edit step).
+pub const HANDLE_UPDATE_COLUMNS: &[&str] = &[
+    "scenario",
+    "method",
+    "step",
+    "handles",
+    "constrained_vertices",
+    "bind_ms",
+    "t_h_ms",
+    "background_wait_ms",
+    "t_b_ms",
+    "t_e_ms",
+    "median_iteration_ms",
+    "iterations",
+];
+
+fn phase(record: &[(String, f64)], name: &str) -> Option<f64> {
+    record.iter().find(|(k, _)| k == name).map(|(_, v)| *v)
+}
+
+/// `handle_updates.csv` contents: the handle-set update time of every step of every case, with
+/// HIRM's phases (Wu et al. 2015, Table 1: `t_e`, `t_b`, `t_h`; `t_i` is the median iteration).
+pub fn render_handle_updates(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let err = |e: csv::Error| HarnessError::Report(format!("CSV: {e}"));
+    w.write_record(HANDLE_UPDATE_COLUMNS).map_err(err)?;
+    let ms =
+        |v: Option<f64>| v.filter(|v| !v.is_nan()).map(|v| format!("{:.4}", 1e3 * v)).unwrap_or_default();
+    for r in results {
+        for s in &r.steps {
+            w.write_record([
+                r.scenario.clone(),
+                r.method.clone(),
+                s.step.to_string(),
+                s.handles.to_string(),
+                s.constrained_vertices.to_string(),
+                ms(Some(s.bind_s)),
+                ms(phase(&s.phase_timings, "t_h_handle_update")),
+                ms(phase(&s.phase_timings, "bind_background_wait")),
+                ms(phase(&s.phase_timings, "t_b_background_precompute")),
+                ms(phase(&s.phase_timings, "t_e_propagation_fields")),
+                ms(Some(s.median_iteration_ms / 1e3)),
+                s.iterations.to_string(),
+            ])
+            .map_err(err)?;
+        }
+    }
+    w.into_inner().map_err(|e| HarnessError::Report(format!("CSV: {e}")))
+}
+
+/// `table1.md`: HIRM's Table 1 for every scenario that runs `hirm` and `isolines`: per step the
+/// number of handles, `hirm`'s handle update `t_h` against the `isolines` rebuild (its whole
+/// `bind_handles`), their ratio `P`, and both per-iteration times.
+pub fn render_table1(results: &[CaseResult]) -> String {
+    let mut out = String::from(
+        "# Handle-set update: `hirm` against the `isolines` rebuild (Wu et al. 2015, Table 1)\n\n\
+         t_h: hirm's handle update (eq 26 and the factorization); rebuild: the whole bind of isolines \
+         (harmonic fields, isolines, reduced system). P = t_h / rebuild. t_i: median iteration.\n\n\
+         | scenario | step | n_h | n_field | n_t | t_e (s) | t_b (s) | t_h (ms) | rebuild (ms) | P (%) | t_i hirm (ms) | t_i isolines (ms) |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    let stat =
+        |r: &CaseResult, name: &str| phase(&r.statistics, name).map_or("-".to_string(), |v| format!("{v}"));
+    for hirm in results.iter().filter(|r| r.method == "hirm") {
+        let Some(isolines) = results.iter().find(|r| r.method == "isolines" && r.scenario == hirm.scenario)
+        else {
+            continue;
+        };
+        for (h, i) in hirm.steps.iter().zip(&isolines.steps) {
+            let t_h = phase(&h.phase_timings, "t_h_handle_update").unwrap_or(f64::NAN);
+            let t_e = phase(&h.phase_timings, "t_e_propagation_fields").unwrap_or(f64::NAN);
+            let t_b = phase(&h.phase_timings, "t_b_background_precompute").unwrap_or(f64::NAN);
+            out.push_str(&format!(
+                "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.2} | {:.1} | {:.3} | {:.3} |\n",
+                hirm.scenario,
+                h.step,
+                h.handles,
+                stat(hirm, "n_field"),
+                stat(hirm, "n_t"),
+                t_e,
+                t_b,
+                1e3 * t_h,
+                1e3 * i.bind_s,
+                100.0 * t_h / i.bind_s,
+                h.median_iteration_ms,
+                i.median_iteration_ms,
+            ));
+        }
+    }
+    out
+}
+
 /// Write `results.csv`, `results.json` and `meshes/<scenario>-<method>.{off,glb}` under `dir`.
 pub fn write_reports(
     dir: &Path,
@@ -104,6 +196,8 @@ pub fn write_reports(
         meshes::io::write_off(mesh_dir.join(format!("{stem}.off")), &mesh)?;
         meshes::io::write_glb(mesh_dir.join(format!("{stem}.glb")), &mesh, None)?;
     }
+    write_bytes(&dir.join("handle_updates.csv"), &render_handle_updates(results)?)?;
+    write_bytes(&dir.join("table1.md"), render_table1(results).as_bytes())?;
     write_bytes(&dir.join("results.json"), &json)?;
     write_bytes(&dir.join("results.csv"), &csv)?;
     Ok(())

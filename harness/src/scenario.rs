@@ -9,6 +9,21 @@
 //! # procedural = { shape = "bar", vertices = 50000 }
 //! # methods = ["laplacian", "arap"]   # default: every registered method
 //! ```
+//!
+//! Incremental editing: `[[steps]]` tables, each a new handle set bound to the result of the step
+//! before (default: one step, the survey edit).
+//!
+//! ```toml
+//! [[steps]]
+//! edit = "survey"        # survey regions: `fixed` held, `handle` moved by the .def transform
+//! [[steps]]
+//! edit = "hold"          # every region of the step before, held where it is
+//! [[steps.patches]]      # plus new handles
+//! name = "middle"
+//! center = [0.5, 0.5, 1.0]       # bbox coordinates of the rest mesh; the nearest vertex is the seed
+//! radius = 0.03                  # vertices within radius x diagonal of the seed (rest positions)
+//! translate = [0.0, 0.0, 0.05]   # target = current position + translate x diagonal
+//! ```
 
 use std::path::{Path, PathBuf};
 
@@ -37,6 +52,9 @@ pub struct ScenarioSpec {
     /// Methods to run (default: all registered).
     #[serde(default)]
     pub methods: Option<Vec<String>>,
+    /// Edit steps (default: the survey edit alone).
+    #[serde(default)]
+    pub steps: Vec<StepSpec>,
     /// The file it was read from.
     #[serde(skip)]
     pub path: PathBuf,
@@ -51,6 +69,78 @@ pub struct ProceduralSpec {
     /// Approximate vertex count (default: the survey original's).
     #[serde(default)]
     pub vertices: Option<usize>,
+}
+
+/// One edit step as written.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StepSpec {
+    /// How the regions of the step before carry over.
+    pub edit: StepEdit,
+    /// New patch handles.
+    #[serde(default)]
+    pub patches: Vec<PatchSpec>,
+}
+
+/// How a step starts its handle set.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum StepEdit {
+    /// The survey regions: `fixed` held, `handle` moved by the survey transform.
+    Survey,
+    /// Every region of the step before, held at its current position.
+    Hold,
+}
+
+/// A patch handle: the vertices near a point of the rest mesh, translated.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PatchSpec {
+    pub name: String,
+    /// A point in the rest bounding box, in `[0, 1]^3` box coordinates; the nearest vertex is the seed.
+    pub center: [f64; 3],
+    /// Radius around the seed, as a fraction of the bounding-box diagonal.
+    pub radius: f64,
+    /// Target offset, as a fraction of the bounding-box diagonal (default: held in place).
+    #[serde(default)]
+    pub translate: [f64; 3],
+}
+
+/// How a region's targets follow from the current shape.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Motion {
+    /// Stay where it is.
+    Hold,
+    /// The affine transform applied to the current positions.
+    Transform(AffineTransform),
+    /// Move by this offset.
+    Translate([f64; 3]),
+}
+
+/// A resolved step: its handle set and how each region moves.
+#[derive(Clone, Debug)]
+pub struct LoadedStep {
+    pub handles: HandleSet,
+    /// One per region of `handles`, in order.
+    pub motions: Vec<Motion>,
+}
+
+impl LoadedStep {
+    /// Targets of the constrained vertices for the `#V x 3` shape `current` the step starts from.
+    pub fn targets(&self, current: &[[f64; 3]]) -> Result<HandleTargets, methods::MethodError> {
+        let mut out = Vec::with_capacity(self.handles.n_constrained());
+        for (region, motion) in self.handles.regions().iter().zip(&self.motions) {
+            out.extend(region.vertices.iter().map(|&v| {
+                let p = current[v as usize];
+                match motion {
+                    Motion::Hold => p,
+                    Motion::Transform(t) => t.apply(p),
+                    Motion::Translate(d) => [p[0] + d[0], p[1] + d[1], p[2] + d[2]],
+                }
+            }));
+        }
+        HandleTargets::new(&self.handles, out)
+    }
 }
 
 /// Where meshes come from for this run.
@@ -69,8 +159,8 @@ pub struct LoadedScenario {
     pub mesh_source: String,
     pub mesh: TriMesh,
     pub topology: Topology,
-    pub handles: HandleSet,
-    pub targets: HandleTargets,
+    /// The edit steps, at least one.
+    pub steps: Vec<LoadedStep>,
 }
 
 /// Read every `*.toml` in `dir`, sorted by file name; names must be unique.
@@ -163,33 +253,117 @@ impl ScenarioSpec {
             )),
             (_, None, None) => return Err(fail("has neither `survey` nor `procedural`".into())),
         };
-        let (handles, targets) =
-            survey_edit(&mesh, &selection, &transform).map_err(|e| fail(e.to_string()))?;
-        Ok(LoadedScenario { spec: self.clone(), mesh_source, mesh, topology, handles, targets })
+        let steps = self.resolve_steps(&mesh, &selection, &transform).map_err(fail)?;
+        Ok(LoadedScenario { spec: self.clone(), mesh_source, mesh, topology, steps })
+    }
+
+    /// The handle sets of the steps on the rest mesh (default: the survey edit alone).
+    fn resolve_steps(
+        &self,
+        mesh: &TriMesh,
+        selection: &[VertexStatus],
+        transform: &AffineTransform,
+    ) -> Result<Vec<LoadedStep>, String> {
+        let default = [StepSpec { edit: StepEdit::Survey, patches: Vec::new() }];
+        let specs = if self.steps.is_empty() { &default[..] } else { &self.steps[..] };
+        let diagonal = mesh.bbox_diagonal();
+        let (lo, hi) = mesh.bbox();
+        let mut steps: Vec<LoadedStep> = Vec::with_capacity(specs.len());
+        for (i, spec) in specs.iter().enumerate() {
+            let at = |message: String| format!("step {}: {message}", i + 1);
+            let (mut regions, mut motions) = match spec.edit {
+                StepEdit::Survey => {
+                    let (handles, motions) =
+                        survey_regions(selection, transform).map_err(|e| at(e.to_string()))?;
+                    (handles, motions)
+                }
+                StepEdit::Hold => {
+                    let Some(previous) = steps.last() else {
+                        return Err(at("`edit = \"hold\"` needs a step before it".into()));
+                    };
+                    (
+                        previous.handles.regions().to_vec(),
+                        vec![Motion::Hold; previous.handles.regions().len()],
+                    )
+                }
+            };
+            let mut taken = vec![false; mesh.n_vertices()];
+            for r in &regions {
+                r.vertices.iter().for_each(|&v| taken[v as usize] = true);
+            }
+            for patch in &spec.patches {
+                let at = |message: String| at(format!("patch `{}`: {message}", patch.name));
+                if !(patch.radius > 0.0 && patch.radius.is_finite())
+                    || patch.center.iter().chain(&patch.translate).any(|c| !c.is_finite())
+                {
+                    return Err(at("radius must be positive and finite, center and translate finite".into()));
+                }
+                let point: [f64; 3] = std::array::from_fn(|c| lo[c] + patch.center[c] * (hi[c] - lo[c]));
+                let p = mesh.positions();
+                let distance = |v: usize| meshes::vector::norm(meshes::vector::sub(p[v], point));
+                let seed = (0..p.len())
+                    .min_by(|&a, &b| distance(a).total_cmp(&distance(b)))
+                    .expect("non-empty mesh");
+                let reach = patch.radius * diagonal;
+                let vertices: Vec<u32> = (0..p.len())
+                    .filter(|&v| {
+                        !taken[v] && meshes::vector::norm(meshes::vector::sub(p[v], p[seed])) <= reach
+                    })
+                    .map(|v| v as u32)
+                    .collect();
+                if vertices.is_empty() {
+                    return Err(at(format!(
+                        "no free vertex within {} x diagonal of vertex {seed}",
+                        patch.radius
+                    )));
+                }
+                vertices.iter().for_each(|&v| taken[v as usize] = true);
+                regions.push(HandleRegion { name: patch.name.clone(), vertices });
+                motions.push(if patch.translate == [0.0; 3] {
+                    Motion::Hold
+                } else {
+                    Motion::Translate(patch.translate.map(|c| c * diagonal))
+                });
+            }
+            let handles = HandleSet::new(regions, mesh.n_vertices()).map_err(|e| at(e.to_string()))?;
+            steps.push(LoadedStep { handles, motions });
+        }
+        Ok(steps)
     }
 }
 
-/// The survey edit as a handle set: region `fixed` (status 0, target = rest position, omitted when
-/// empty) and region `handle` (status 2, target = `T (x, y, z, 1)`).
-pub fn survey_edit(
-    mesh: &TriMesh,
+/// The survey regions: `fixed` (status 0, held; omitted when empty) and `handle` (status 2, moved by
+/// `transform`).
+fn survey_regions(
     selection: &[VertexStatus],
     transform: &AffineTransform,
-) -> Result<(HandleSet, HandleTargets), methods::MethodError> {
+) -> Result<(Vec<HandleRegion>, Vec<Motion>), methods::MethodError> {
     let fixed = meshes::edit::vertices_with_status(selection, VertexStatus::Fixed);
     let handle = meshes::edit::vertices_with_status(selection, VertexStatus::Handle);
     if handle.is_empty() {
         return Err(methods::MethodError::Handles("the selection has no handle vertices (code 2)".into()));
     }
-    let p = mesh.positions();
-    let mut targets: Vec<[f64; 3]> = fixed.iter().map(|&v| p[v as usize]).collect();
-    targets.extend(handle.iter().map(|&v| transform.apply(p[v as usize])));
     let mut regions = Vec::new();
+    let mut motions = Vec::new();
     if !fixed.is_empty() {
         regions.push(HandleRegion { name: "fixed".into(), vertices: fixed });
+        motions.push(Motion::Hold);
     }
     regions.push(HandleRegion { name: "handle".into(), vertices: handle });
-    let handles = HandleSet::new(regions, mesh.n_vertices())?;
-    let targets = HandleTargets::new(&handles, targets)?;
-    Ok((handles, targets))
+    motions.push(Motion::Transform(transform.clone()));
+    Ok((regions, motions))
+}
+
+/// The survey edit on the rest mesh as a handle set and its targets: region `fixed` (status 0,
+/// target = rest position, omitted when empty) and region `handle` (status 2, target =
+/// `T (x, y, z, 1)`).
+pub fn survey_edit(
+    mesh: &TriMesh,
+    selection: &[VertexStatus],
+    transform: &AffineTransform,
+) -> Result<(HandleSet, HandleTargets), methods::MethodError> {
+    let (regions, motions) = survey_regions(selection, transform)?;
+    let step = LoadedStep { handles: HandleSet::new(regions, mesh.n_vertices())?, motions };
+    let targets = step.targets(mesh.positions())?;
+    Ok((step.handles, targets))
 }

@@ -4,8 +4,9 @@
 use crate::topology::Topology;
 use crate::vector::{angle_between, cross, norm, normalize_or_zero, sub};
 
-/// Diagonal of the axis-aligned bounding box of `#V x 3` positions (0 for no points).
-pub fn bbox_diagonal(positions: &[[f64; 3]]) -> f64 {
+/// Corners `(min, max)` of the axis-aligned bounding box of `#V x 3` positions (infinite for no
+/// points).
+pub fn bbox(positions: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in positions {
@@ -14,9 +15,15 @@ pub fn bbox_diagonal(positions: &[[f64; 3]]) -> f64 {
             hi[k] = hi[k].max(p[k]);
         }
     }
+    (lo, hi)
+}
+
+/// Diagonal of the axis-aligned bounding box of `#V x 3` positions (0 for no points).
+pub fn bbox_diagonal(positions: &[[f64; 3]]) -> f64 {
     if positions.is_empty() {
         return 0.0;
     }
+    let (lo, hi) = bbox(positions);
     norm(sub(hi, lo))
 }
 

@@ -74,6 +74,11 @@ impl TriMesh {
         Ok(Self { positions, triangles: self.triangles.clone() })
     }
 
+    /// Corners `(min, max)` of the axis-aligned bounding box.
+    pub fn bbox(&self) -> ([f64; 3], [f64; 3]) {
+        crate::geometry::bbox(&self.positions)
+    }
+
     /// Diagonal length of the axis-aligned bounding box.
     pub fn bbox_diagonal(&self) -> f64 {
         crate::geometry::bbox_diagonal(&self.positions)
