@@ -96,11 +96,6 @@ impl BackgroundPrecompute {
         Self { worker }
     }
 
-    /// Whether the result is ready (joining will not block).
-    pub fn is_finished(&self) -> bool {
-        self.worker.is_finished()
-    }
-
     /// Wait for the result.
     pub fn finish(self) -> Result<HandleIndependentModel, MethodError> {
         self.worker.join().map_err(|_| MethodError::Background { method: "hirm" })
