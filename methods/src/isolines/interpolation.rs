@@ -86,7 +86,7 @@ impl IsolineModel {
     /// Build the model on the `#V x 3` base shape `base` from `#V x #sets` scalar fields with values
     /// in `[0, 1]` (one isoline set per column): `n_iso` isolines per set, at most
     /// `max_crossed_triangles` sampled triangles in all, sets blended by `blend`.
-    /// `delta_bar = L X_base` is filled in by [`ReducedSystem::handle_independent`], which has `L`.
+    /// `delta_bar = L X_base` is filled in by [`HandleIndependentSystem::new`], which has `L`.
     pub fn new(
         base: &[[f64; 3]],
         triangles: &[[u32; 3]],
@@ -524,20 +524,24 @@ impl HandleIndependentSystem {
         }
         let c = 4 * touched.len();
         let mut block = vec![0.0f64; c * c]; // column major
+        let mut local: Vec<(usize, f64)> = Vec::new();
         for v in handles.constrained() {
             let x = model.base[v as usize];
             let h = [x[0], x[1], x[2], 1.0];
-            let weights = model.vertex_weights(v as usize);
-            for &(mq, wq) in weights {
-                let lq = 4 * local_of[mq as usize];
+            local.clear();
+            local
+                .extend(model.vertex_weights(v as usize).iter().map(|&(m, w)| (4 * local_of[m as usize], w)));
+            for &(lq, wq) in &local {
                 for (d, hd) in h.iter().enumerate() {
                     let column = &mut block[(lq + d) * c..(lq + d + 1) * c];
                     let s = w2 * wq * hd;
-                    for &(mp, wp) in weights {
-                        let lp = 4 * local_of[mp as usize];
+                    for &(lp, wp) in &local {
                         let f = s * wp;
-                        for (e, he) in h.iter().enumerate() {
-                            column[lp + e] += f * he;
+                        // A fixed-size chunk: one bounds check and a 4-wide update.
+                        let cell: &mut [f64; 4] =
+                            (&mut column[lp..lp + 4]).try_into().expect("4 columns per isoline");
+                        for (o, he) in cell.iter_mut().zip(&h) {
+                            *o += f * he;
                         }
                     }
                 }
