@@ -131,7 +131,6 @@ pub fn run_case(
             let step_solve_s = t.elapsed().as_secs_f64();
             solve_s += step_solve_s;
             result.iterations += summary.iterations;
-            result.converged = summary.converged && (i == 0 || result.converged);
             result.steps.push(StepRecord {
                 step: i + 1,
                 handles: step.handles.regions().len(),
@@ -143,15 +142,16 @@ pub fn run_case(
                 median_iteration_ms: median_ms(&recorder.0[first_iteration..]),
                 phase_timings: m.phase_timings().into_iter().map(|(k, v)| (k.to_string(), v)).collect(),
             });
-            final_edit = Some((step, targets, summary.iterations));
+            final_edit = Some((step, targets));
         }
+        result.converged = result.steps.iter().all(|s| s.converged);
         let positions = m.positions();
         result.bind_s = result.steps.first().map_or(f64::NAN, |s| s.bind_s);
         result.solve_s = solve_s;
         result.total_s = start.elapsed().as_secs_f64();
         result.phase_timings = m.phase_timings().into_iter().map(|(k, v)| (k.to_string(), v)).collect();
         result.statistics = m.model_statistics().into_iter().map(|(k, v)| (k.to_string(), v)).collect();
-        let (step, targets, _) = final_edit.expect("a scenario has at least one step");
+        let (step, targets) = final_edit.expect("a scenario has at least one step");
         if let Some(v) = positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
             return Err(methods::MethodError::NonFinite {
                 method: m.name(),

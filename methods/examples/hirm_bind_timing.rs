@@ -1,5 +1,5 @@
-//! `hirm_bind_timing MESH.off MESH.sel`: HIRM's handle update time `t_h` for the survey handle set,
-//! bound several times in one process.
+//! `[BINDS=N] hirm_bind_timing MESH.off MESH.sel`: HIRM's handle update time `t_h` for the survey
+//! handle set (fixed and handle regions), bound N times (default 5) in one process.
 use methods::{DeformationMethod, HandleRegion, HandleSet};
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();

@@ -6,6 +6,7 @@
 use meshes::shapes::{generate, ShapeKind};
 use meshes::{TriMesh, VertexStatus};
 use methods::hirm::{handle_independent_model, propagation_fields, select_fields, Hirm, HirmParams};
+use methods::operators::cotan_laplacian;
 use methods::{DeformationMethod, HandleRegion, HandleSet, HandleTargets, MethodError, NoObserver};
 
 /// Tolerance of the fixed-point tests, relative to the bounding-box diagonal (see
@@ -71,7 +72,8 @@ fn strip_selects_its_three_longitudinal_modes() {
     // Neumann modes of a 10 x 1 strip: lambda = pi^2 (m^2 / 100 + n^2). With n = 0 the scores are
     // m = 1, 2, 3, 4, ...; the first transverse mode scores 10. phi = 3.5 keeps m = 1, 2, 3.
     let mesh = strip(10.0, 100);
-    let fields = propagation_fields(mesh.positions(), mesh.triangles(), 3.5, 20, 7).unwrap();
+    let laplacian = cotan_laplacian(mesh.positions(), mesh.triangles());
+    let fields = propagation_fields(mesh.positions(), mesh.triangles(), &laplacian, 3.5, 20, 7).unwrap();
     assert_eq!(fields.scores.len(), 3, "scores {:?}", fields.scores);
     for (m, s) in fields.scores.iter().enumerate() {
         assert!((s - (m + 1) as f64).abs() < 0.02 * (m + 1) as f64, "score {s} of mode {}", m + 1);

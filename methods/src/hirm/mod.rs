@@ -32,7 +32,7 @@ pub mod propagation_fields;
 use std::sync::Arc;
 use std::time::Instant;
 
-use faer::linalg::solvers::{Llt, SolveCore};
+use faer::linalg::solvers::Llt;
 use faer::{Mat, Side};
 use meshes::{Topology, TriMesh};
 use serde::Deserialize;
@@ -42,8 +42,10 @@ pub use propagation_fields::{propagation_fields, select_fields, PropagationField
 
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
-use crate::isolines::{constraint_rhs, RotationFit};
-use crate::method::{DeformationMethod, IterationObserver, IterationReport, SolveSummary};
+use crate::isolines::{
+    checked_positions, constraint_rhs, finish_reduced_iteration, ReducedIteration, RotationFit,
+};
+use crate::method::{DeformationMethod, IterationObserver, SolveSummary};
 use crate::operators::cotan_laplacian;
 
 /// Parameters of [`Hirm`] (configs/methods.toml, section `[hirm]`).
@@ -152,11 +154,6 @@ impl Hirm {
         })
     }
 
-    /// `S_i` of the selected propagation fields (their number is `n_field`).
-    pub fn field_scores(&self) -> Option<&[f64]> {
-        self.rest.as_ref().map(|r| r.scores.as_slice())
-    }
-
     /// What the handle-independent system is built from (after `precompute`).
     pub fn system_inputs(&self) -> Option<Arc<SystemInputs>> {
         self.rest.as_ref().map(|r| r.inputs.clone())
@@ -203,9 +200,11 @@ impl DeformationMethod for Hirm {
             worker.finish()?;
         }
         let start = Instant::now();
+        let laplacian = cotan_laplacian(rest.positions(), rest.triangles());
         let fields = propagation_fields(
             rest.positions(),
             rest.triangles(),
+            &laplacian,
             self.params.threshold,
             self.params.max_fields,
             self.params.seed,
@@ -215,7 +214,7 @@ impl DeformationMethod for Hirm {
             triangles: rest.triangles().to_vec(),
             fields: fields.fields,
             weights: fields.weights,
-            laplacian: cotan_laplacian(rest.positions(), rest.triangles()),
+            laplacian,
             isolines: self.params.isolines,
             max_crossed_triangles: self.params.max_crossed_triangles,
             mu: self.params.mu,
@@ -277,33 +276,23 @@ impl DeformationMethod for Hirm {
             let rotations = model.isoline_rotations(&probes, RotationFit::ScaledOrthogonal);
             let mut rhs = &system.laplacian_rhs * &rotations;
             rhs += &constraints;
-            bound.factor.solve_in_place_with_conj(faer::Conj::No, rhs.as_mut());
-            self.reduced = rhs;
-            let next = model.probe_positions(self.reduced.as_ref());
-            if let Some(i) = next.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-                let vertex = model.probe_vertex(i) as usize;
-                return Err(MethodError::NonFinite { method: "hirm", vertex, iteration });
-            }
-            let step = crate::method::max_displacement(&probes, &next) / rest.bbox_diagonal;
-            probes = next;
-            let report = IterationReport { iteration, step, seconds: start.elapsed().as_secs_f64() };
-            summary = SolveSummary {
-                iterations: iteration + 1,
-                converged: step < self.params.tolerance,
-                final_step: step,
-            };
-            let reduced = &self.reduced;
-            let flow = observer.on_iteration(&report, &|| model.positions(reduced.as_ref()));
-            if summary.converged || flow.is_break() {
+            let stop;
+            (summary, stop) = finish_reduced_iteration(
+                ReducedIteration { method: "hirm", iteration, start, model, factor: &bound.factor },
+                rhs,
+                &mut self.reduced,
+                &mut probes,
+                rest.bbox_diagonal,
+                self.params.tolerance,
+                observer,
+            )?;
+            if stop {
                 break;
             }
         }
         // Eq 21 / 28 for every vertex, once.
         let t1 = Instant::now();
-        let current = model.positions(self.reduced.as_ref());
-        if let Some(i) = current.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-            return Err(MethodError::NonFinite { method: "hirm", vertex: i, iteration: summary.iterations });
-        }
+        let current = checked_positions("hirm", model, self.reduced.as_ref(), summary.iterations)?;
         let positions_seconds = t1.elapsed().as_secs_f64();
         // Section 4.5: the next handle set's T_1, T_2 are computed on this shape in the background.
         let worker = BackgroundPrecompute::start(current.clone(), rest.inputs.clone());

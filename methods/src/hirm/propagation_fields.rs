@@ -10,10 +10,11 @@
 //! - For isoline sampling each field is rescaled affinely to `[0, 1]` (min to 0, max to 1); the
 //!   weights use the unscaled eigenvectors.
 
+use faer::sparse::SparseColMat;
 use faer::Mat;
 
 use crate::error::MethodError;
-use crate::operators::{cotan_laplacian, lumped_mass, MassKind};
+use crate::operators::{lumped_mass, MassKind};
 use crate::spectral::{smallest_eigenpairs, transform, EigenOptions};
 
 /// The selected fields of a rest mesh.
@@ -42,18 +43,20 @@ pub fn select_fields(eigenvalues: &[f64], threshold: f64) -> Option<usize> {
     Some(eigenvalues[1..].iter().take_while(|&&l| (l / lambda_2).sqrt() < threshold).count())
 }
 
-/// The propagation fields of the rest mesh (`#V x 3` positions, triangles): eigenpairs are computed
-/// in growing batches until one scores at or above `threshold`, or `max_fields` fields are found.
-/// `seed` seeds the eigensolver's start vectors.
+/// The propagation fields of the rest mesh (`#V x 3` positions, triangles, and its `#V x #V`
+/// cotangent Laplacian `laplacian`): eigenpairs are computed in growing batches until one scores at
+/// or above `threshold`, or `max_fields` fields are found. `seed` seeds the eigensolver's start
+/// vectors.
 pub fn propagation_fields(
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
+    laplacian: &SparseColMat<usize, f64>,
     threshold: f64,
     max_fields: usize,
     seed: u64,
 ) -> Result<PropagationFields, MethodError> {
     let n = positions.len();
-    let mut stiffness = cotan_laplacian(positions, triangles);
+    let mut stiffness = laplacian.clone();
     stiffness.val_mut().iter_mut().for_each(|v| *v = -*v);
     let mass = lumped_mass(positions, triangles, MassKind::Barycentric);
     let wanted = (max_fields + 1).min(n);

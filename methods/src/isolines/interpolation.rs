@@ -2,13 +2,14 @@
 //!
 //! [`IsolineModel`] holds the isolines (`N = #sets x n_iso`, numbered `m = set * n_iso + j`), the
 //! two-level interpolation weights `w_{k,m}` of every vertex (section 4.2: linear between the two
-//! isolines around `phi_{i,k}`, times `phi_{i,k}` across handles), and the sampled crossed triangles
-//! with their base frames. With the weights, `W_x[k, 4m + c] = w_{k,m} x_bar_k[c]` (homogeneous
+//! isolines around `phi_{i,k}`, times the set weight of [`SetBlend`]: `phi_{i,k}` across handles, or
+//! HIRM's constant `omega_bar_i`), and the sampled crossed triangles with their base frames. With the weights, `W_x[k, 4m + c] = w_{k,m} x_bar_k[c]` (homogeneous
 //! `x_bar_k`) and `W_delta[k, 3m + c] = w_{k,m} delta_bar_k[c]`; both are applied row by row and never
 //! stored densely (`#V x 4N` would not fit for large meshes with many handles).
 //!
-//! [`ReducedSystem`] is what eq 10 needs: `U^T U` (`4N x 4N`), `W_x^T L^T W_delta` (`4N x 3N`) and the
-//! constraint right-hand side.
+//! [`HandleIndependentSystem`] holds the parts of eq 10's matrices that do not depend on the handles
+//! (`W_x^T L^T L W_x + beta^2 M^T M`, `W_x^T L^T W_delta`); [`ReducedSystem`] adds a handle set's
+//! constraint term to give `U^T U` (`4N x 4N`) and the constraint right-hand side.
 
 use faer::sparse::SparseColMatRef;
 use faer::{Mat, MatRef};

@@ -46,7 +46,7 @@ pub mod tracing;
 use std::time::Instant;
 
 use faer::linalg::solvers::{Llt, SolveCore};
-use faer::{Mat, Side};
+use faer::{Mat, MatRef, Side};
 use meshes::vector::{cross, dot, normalize_or_zero, scale, sub};
 use meshes::{Topology, TriMesh};
 use serde::Deserialize;
@@ -292,32 +292,28 @@ impl DeformationMethod for Isolines {
                     );
                 }
             }
-            bound.factor.solve_in_place_with_conj(faer::Conj::No, rhs.as_mut());
-            self.reduced = rhs;
-            let next = bound.model.probe_positions(self.reduced.as_ref());
-            if let Some(i) = next.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-                let vertex = bound.model.probe_vertex(i) as usize;
-                return Err(MethodError::NonFinite { method: name, vertex, iteration });
-            }
-            let step = crate::method::max_displacement(&probes, &next) / rest.bbox_diagonal;
-            probes = next;
-            let report = IterationReport { iteration, step, seconds: start.elapsed().as_secs_f64() };
-            summary = SolveSummary {
-                iterations: iteration + 1,
-                converged: step < self.params.tolerance,
-                final_step: step,
-            };
-            let (model, reduced) = (&bound.model, &self.reduced);
-            let flow = observer.on_iteration(&report, &|| model.positions(reduced.as_ref()));
-            if summary.converged || flow.is_break() {
+            let stop;
+            (summary, stop) = finish_reduced_iteration(
+                ReducedIteration {
+                    method: name,
+                    iteration,
+                    start,
+                    model: &bound.model,
+                    factor: &bound.factor,
+                },
+                rhs,
+                &mut self.reduced,
+                &mut probes,
+                rest.bbox_diagonal,
+                self.params.tolerance,
+                observer,
+            )?;
+            if stop {
                 break;
             }
         }
         let t1 = Instant::now();
-        self.current = bound.model.positions(self.reduced.as_ref());
-        if let Some(i) = self.current.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-            return Err(MethodError::NonFinite { method: name, vertex: i, iteration: summary.iterations });
-        }
+        self.current = checked_positions(name, &bound.model, self.reduced.as_ref(), summary.iterations)?;
         self.timings.retain(|(k, _)| !k.starts_with("solve_"));
         self.timings.extend([
             ("solve_constraint_rhs", setup),
@@ -338,6 +334,63 @@ impl DeformationMethod for Isolines {
         self.bound.as_ref().map_or_else(Vec::new, |b| {
             vec![("n_isolines", b.model.n_isolines() as f64), ("n_tri", b.model.n_sampled_triangles() as f64)]
         })
+    }
+}
+
+/// What [`finish_reduced_iteration`] needs to know of the iteration and the bound model.
+pub(crate) struct ReducedIteration<'a> {
+    pub method: &'static str,
+    /// 0-based index within the solve.
+    pub iteration: usize,
+    /// When the iteration's own work started.
+    pub start: Instant,
+    pub model: &'a IsolineModel,
+    /// `LL^T` of `U^T U`.
+    pub factor: &'a Llt<f64>,
+}
+
+/// The end of one iteration of an isoline reduced model (Au et al. 2007 eq 10, HIRM eq 20): solve
+/// `U^T U R = rhs` (`4N x 3`) into `reduced`, move the probe vertices (`probes`, the sampled
+/// triangles' corners) and check them, report the step (largest probe displacement over `diagonal`)
+/// and the iteration time to `observer`. Returns the summary so far and whether to stop (converged
+/// below `tolerance`, or the observer asked).
+pub(crate) fn finish_reduced_iteration(
+    it: ReducedIteration<'_>,
+    mut rhs: Mat<f64>,
+    reduced: &mut Mat<f64>,
+    probes: &mut Vec<[f64; 3]>,
+    diagonal: f64,
+    tolerance: f64,
+    observer: &mut dyn IterationObserver,
+) -> Result<(SolveSummary, bool), MethodError> {
+    it.factor.solve_in_place_with_conj(faer::Conj::No, rhs.as_mut());
+    *reduced = rhs;
+    let next = it.model.probe_positions(reduced.as_ref());
+    if let Some(i) = next.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+        let vertex = it.model.probe_vertex(i) as usize;
+        return Err(MethodError::NonFinite { method: it.method, vertex, iteration: it.iteration });
+    }
+    let step = crate::method::max_displacement(probes, &next) / diagonal;
+    *probes = next;
+    let report = IterationReport { iteration: it.iteration, step, seconds: it.start.elapsed().as_secs_f64() };
+    let summary =
+        SolveSummary { iterations: it.iteration + 1, converged: step < tolerance, final_step: step };
+    let (model, reduced) = (it.model, &*reduced);
+    let flow = observer.on_iteration(&report, &|| model.positions(reduced.as_ref()));
+    Ok((summary, summary.converged || flow.is_break()))
+}
+
+/// `W_x R_x` for every vertex (`#V x 3`), or the first non-finite vertex as an error.
+pub(crate) fn checked_positions(
+    method: &'static str,
+    model: &IsolineModel,
+    reduced: MatRef<'_, f64>,
+    iterations: usize,
+) -> Result<Vec<[f64; 3]>, MethodError> {
+    let positions = model.positions(reduced);
+    match positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+        Some(vertex) => Err(MethodError::NonFinite { method, vertex, iteration: iterations }),
+        None => Ok(positions),
     }
 }
 
