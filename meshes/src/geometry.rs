@@ -40,13 +40,17 @@ pub fn face_areas(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<f64> {
 
 /// `#F` unit face normals (right-hand rule on the corner order); zero for a zero-area face.
 pub fn face_normals(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<[f64; 3]> {
-    triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| positions[i as usize]);
-            normalize_or_zero(cross(sub(b, a), sub(c, a)))
-        })
-        .collect()
+    let mut out = vec![[0.0; 3]; triangles.len()];
+    face_normals_into(positions, triangles, &mut out);
+    out
+}
+
+/// [`face_normals`] into a preallocated `#F x 3` buffer (no allocation; for iteration loops).
+pub fn face_normals_into(positions: &[[f64; 3]], triangles: &[[u32; 3]], out: &mut [[f64; 3]]) {
+    for (n, t) in out.iter_mut().zip(triangles) {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        *n = normalize_or_zero(cross(sub(b, a), sub(c, a)));
+    }
 }
 
 /// `#V` unit vertex normals, the area-weighted mean of the adjacent face normals.

@@ -19,24 +19,34 @@ pub enum MassKind {
 /// [`DEGENERATE_FACE_RATIO`], contribute nothing).
 pub fn lumped_mass(positions: &[[f64; 3]], triangles: &[[u32; 3]], kind: MassKind) -> Vec<f64> {
     let mut mass = vec![0.0; positions.len()];
-    for t in triangles {
-        let p = t.map(|i| positions[i as usize]);
-        let e = [sub(p[2], p[1]), sub(p[0], p[2]), sub(p[1], p[0])]; // e[k] opposite corner k
-        let l2 = e.map(|v| dot(v, v));
-        let double_area = norm(cross(e[0], e[1]));
-        if !(double_area > DEGENERATE_FACE_RATIO * l2.iter().fold(0.0, |a: f64, &b| a.max(b))) {
-            continue;
-        }
-        let area = 0.5 * double_area;
-        let corner = match kind {
-            MassKind::Barycentric => [area / 3.0; 3],
-            MassKind::Voronoi => voronoi_corner_areas(e, l2, double_area, area),
-        };
+    for (t, corner) in triangles.iter().zip(corner_areas(positions, triangles, kind)) {
         for k in 0..3 {
             mass[t[k] as usize] += corner[k];
         }
     }
     mass
+}
+
+/// `#F x 3` share of each face's area at each of its corners (entry `k`: corner `k`); each row sums
+/// to the face area, zero for faces caught by [`DEGENERATE_FACE_RATIO`].
+pub fn corner_areas(positions: &[[f64; 3]], triangles: &[[u32; 3]], kind: MassKind) -> Vec<[f64; 3]> {
+    triangles
+        .iter()
+        .map(|t| {
+            let p = t.map(|i| positions[i as usize]);
+            let e = [sub(p[2], p[1]), sub(p[0], p[2]), sub(p[1], p[0])]; // e[k] opposite corner k
+            let l2 = e.map(|v| dot(v, v));
+            let double_area = norm(cross(e[0], e[1]));
+            if !(double_area > DEGENERATE_FACE_RATIO * l2.iter().fold(0.0, |a: f64, &b| a.max(b))) {
+                return [0.0; 3];
+            }
+            let area = 0.5 * double_area;
+            match kind {
+                MassKind::Barycentric => [area / 3.0; 3],
+                MassKind::Voronoi => voronoi_corner_areas(e, l2, double_area, area),
+            }
+        })
+        .collect()
 }
 
 fn voronoi_corner_areas(e: [[f64; 3]; 3], l2: [f64; 3], double_area: f64, area: f64) -> [f64; 3] {

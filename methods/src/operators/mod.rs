@@ -8,7 +8,7 @@ mod cotan;
 mod mass;
 
 pub use cotan::{cotan_laplacian, cotangent_weights, CotangentWeights};
-pub use mass::{lumped_mass, MassKind};
+pub use mass::{corner_areas, lumped_mass, MassKind};
 
 /// Faces whose doubled area is below this fraction of their longest squared edge carry no
 /// cotangent or mass: a zero-area triangle has no angles, and letting it in would put `inf`/NaN

@@ -1,0 +1,449 @@
+//! `scale_aware`: scale-aware shape manipulation (Liu, Wang, Liu & Liu), and its optimal rigidity
+//! approximation `scale_aware_ora`.
+//!
+//! Section 3: a mesh is represented by its scale-invariant measures `Omega` — triangle angles and
+//! edge angles ([`scale_invariant_measures`]) — which determine it up to a similarity. With the
+//! face normals `N` known, every corner gives the linear equation `e_{i+1} = l_i R_i e_i` (eq 1–2),
+//! all corners together the scale-aware equations `G(Theta, N) V = 0` (eq 3,
+//! [`scale_aware_equations`]); the edge angles constrain the normals (eq 4).
+//!
+//! Section 4, Algorithm 1: from an initial guess, alternate
+//! - step one ([`gauss_map`]): the normals of the current shape are moved on the Gauss map towards
+//!   the rest edge angles by local/global ARAP iterations on the normal pyramids (eq 7–11);
+//! - step two: with the normals fixed, `min |G V|^2 + lambda sum_{j in C} |v_j - v_j*|^2` (eq 12,
+//!   `lambda = 100`), i.e. `(G^T G + lambda C) V = lambda C V*`, a `3#V x 3#V` sparse system whose
+//!   values change with the normals: the symbolic factorization is computed once in `precompute`,
+//!   the numeric one every outer iteration, then one back-substitution.
+//!
+//! Section 5.2: the initial guess is linear Laplacian editing (Sorkine et al. 2004), here iteration
+//! 0 of [`crate::laplacian`] from the current shape. Section 5.3 ([`optimal_rigidity`]):
+//! `scale_aware_ora` rescales every triangle of the converged result to its rest area and stitches
+//! them (eq 13–15).
+//!
+//! Decisions the paper leaves open (tested in `methods/tests/scale_aware.rs`):
+//! - Iterations reported to the observer: iteration 0 is the initialization, 1.. are the outer
+//!   iterations of Algorithm 1; `scale_aware_ora` reports the stitching as one more iteration.
+//!   Convergence is Algorithm 1's: the largest vertex step of an outer iteration below
+//!   `tolerance x bbox diagonal` (the stitching step does not count).
+//! - At least three constrained vertices are required (section 4, "at least three"); fewer leave
+//!   the similarity of `G` undetermined.
+//! - Every solve starts from the Laplacian initialization of the current shape, so a second edit
+//!   step is handled like the first.
+
+pub mod anderson;
+pub mod gauss_map;
+pub mod optimal_rigidity;
+pub mod scale_aware_equations;
+pub mod scale_invariant_measures;
+pub mod vertex_recovery;
+
+use std::ops::ControlFlow;
+use std::time::Instant;
+
+use faer::Mat;
+use meshes::geometry::{face_areas, face_normals_into};
+use meshes::{Topology, TriMesh};
+use serde::Deserialize;
+
+pub use anderson::AndersonAcceleration;
+pub use gauss_map::{NormalPyramids, NormalUpdate};
+pub use optimal_rigidity::{rescaled_triangles, Stitching};
+pub use scale_aware_equations::ScaleAwareEquations;
+pub use scale_invariant_measures::ScaleInvariantMeasures;
+pub use vertex_recovery::{RecoveryTimings, VertexRecovery};
+
+use crate::error::MethodError;
+use crate::handles::{HandleSet, HandleTargets};
+use crate::laplacian::{LaplacianEditing, LaplacianParams};
+use crate::method::{
+    finish_iteration, max_displacement, move_to, report_iteration, DeformationMethod, IterationObserver,
+    IterationReport, NoObserver, SolveSummary,
+};
+use crate::rotation_fit::Mat3;
+
+/// Parameters of [`ScaleAware`] (configs/methods.toml, sections `[scale_aware]` and
+/// `[scale_aware_ora]`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ScaleAwareParams {
+    /// `lambda` of eq 12, the soft handle-constraint weight (the paper: 100).
+    pub constraint_weight: f64,
+    /// Limit on the outer iterations of Algorithm 1 per solve.
+    pub max_iterations: usize,
+    /// Converged when an outer iteration moves no vertex by more than `tolerance x bbox diagonal`.
+    pub tolerance: f64,
+    /// Limit on the local/global iterations of step one per outer iteration (the paper: "usually
+    /// 5–20").
+    pub normal_iterations: usize,
+    /// Step one stops once no normal moves by more than this (radians).
+    pub normal_tolerance: f64,
+    /// Soft-constraint weight `omega` of the Laplacian-editing initialization (section 5.2).
+    pub initialization_omega: f64,
+    /// Anderson acceleration depth (0: off).
+    pub anderson_depth: usize,
+    /// Apply the optimal rigidity approximation (section 5.3) to the converged result.
+    pub optimal_rigidity: bool,
+}
+
+impl Default for ScaleAwareParams {
+    fn default() -> Self {
+        Self {
+            constraint_weight: 100.0,
+            max_iterations: 50,
+            tolerance: 1e-4,
+            normal_iterations: 20,
+            normal_tolerance: 1e-4,
+            initialization_omega: 1000.0,
+            optimal_rigidity: false,
+            anderson_depth: 5,
+        }
+    }
+}
+
+/// Everything built from the rest mesh.
+struct RestState {
+    triangles: Vec<[u32; 3]>,
+    equations: ScaleAwareEquations,
+    pyramids: NormalPyramids,
+    rest_areas: Vec<f64>,
+    bbox_diagonal: f64,
+}
+
+/// Everything built for one handle set.
+struct BoundState {
+    handles: HandleSet,
+    /// `3 #V`: `lambda` on the coordinates of constrained vertices.
+    constraint_diagonal: Vec<f64>,
+    stitching: Option<Stitching>,
+}
+
+/// Accumulated phase times of the last solve, in seconds.
+#[derive(Clone, Copy, Debug, Default)]
+struct SolveTimings {
+    initialization: f64,
+    step_one_normals: f64,
+    recovery: RecoveryTimings,
+    stitching: f64,
+    outer_iterations: usize,
+    normal_iterations: usize,
+}
+
+/// Scale-aware shape manipulation; see the module documentation.
+pub struct ScaleAware {
+    name: &'static str,
+    params: ScaleAwareParams,
+    initialization: LaplacianEditing,
+    rest: Option<RestState>,
+    /// Step two's system (eq 12) and its factorization.
+    recovery: Option<VertexRecovery>,
+    bound: Option<BoundState>,
+    current: Vec<[f64; 3]>,
+    // Storage reused by every outer iteration.
+    normals: Vec<[f64; 3]>,
+    rotations: Vec<Mat3>,
+    frames: Vec<Mat3>,
+    rhs: Mat<f64>,
+    solution: Mat<f64>,
+    flat_x: Vec<f64>,
+    flat_g: Vec<f64>,
+    flat_next: Vec<f64>,
+    timings: SolveTimings,
+}
+
+impl ScaleAware {
+    /// A method registered as `name` with the given parameters; call
+    /// [`DeformationMethod::precompute`] next.
+    pub fn new(name: &'static str, params: ScaleAwareParams) -> Result<Self, MethodError> {
+        let valid = params.constraint_weight > 0.0
+            && params.constraint_weight.is_finite()
+            && params.max_iterations >= 1
+            && params.tolerance >= 0.0
+            && params.normal_iterations >= 1
+            && params.normal_tolerance >= 0.0
+            && params.initialization_omega > 0.0
+            && params.anderson_depth <= anderson::MAX_DEPTH;
+        if !valid {
+            return Err(MethodError::Parameters {
+                method: name,
+                message: "constraint_weight and initialization_omega must be > 0, max_iterations and \
+                          normal_iterations >= 1, tolerance and normal_tolerance >= 0, anderson_depth <= 16"
+                    .into(),
+            });
+        }
+        let initialization = LaplacianEditing::new(LaplacianParams {
+            omega: params.initialization_omega,
+            max_iterations: 1,
+            tolerance: 0.0,
+        })?;
+        Ok(Self {
+            name,
+            params,
+            initialization,
+            rest: None,
+            recovery: None,
+            bound: None,
+            current: Vec::new(),
+            normals: Vec::new(),
+            rotations: Vec::new(),
+            frames: Vec::new(),
+            rhs: Mat::zeros(0, 1),
+            solution: Mat::zeros(0, 3),
+            flat_x: Vec::new(),
+            flat_g: Vec::new(),
+            flat_next: Vec::new(),
+            timings: SolveTimings::default(),
+        })
+    }
+
+    /// Section 5.2: linear Laplacian editing from the current shape (iteration 0 of `laplacian`).
+    fn initialize(&mut self, targets: &HandleTargets) -> Result<(), MethodError> {
+        self.initialization.set_current_shape(&self.current);
+        self.initialization.solve(targets, &mut NoObserver)?;
+        self.current = self.initialization.positions();
+        Ok(())
+    }
+
+    /// Step one (section 4.2): the normals of the current shape, moved towards the rest edge angles.
+    fn update_normals(&mut self) {
+        let rest = self.rest.as_ref().expect("precomputed");
+        face_normals_into(&self.current, &rest.triangles, &mut self.normals);
+        let update = rest.pyramids.update_normals(
+            &mut self.normals,
+            &mut self.rotations,
+            &mut self.frames,
+            self.params.normal_iterations,
+            self.params.normal_tolerance,
+        );
+        self.timings.normal_iterations += update.iterations;
+    }
+
+    /// Step two (section 4.3, eq 12): the positions for the current normals into `self.solution`
+    /// (`#V x 3`).
+    fn recover_vertices(&mut self, targets: &HandleTargets) -> Result<(), MethodError> {
+        let rest = self.rest.as_ref().expect("precomputed");
+        let bound = self.bound.as_ref().expect("bound");
+        self.rhs.fill(0.0);
+        let lambda = self.params.constraint_weight;
+        for (v, target) in bound.handles.constrained().zip(targets.positions()) {
+            for c in 0..3 {
+                self.rhs[(3 * v as usize + c, 0)] = lambda * target[c];
+            }
+        }
+        self.recovery.as_mut().expect("precomputed").solve(
+            &rest.equations,
+            &self.normals,
+            &bound.constraint_diagonal,
+            &mut self.rhs,
+            &mut self.timings.recovery,
+        )?;
+        for i in 0..self.current.len() {
+            for c in 0..3 {
+                self.solution[(i, c)] = self.rhs[(3 * i + c, 0)];
+            }
+        }
+        Ok(())
+    }
+
+    /// Replace `self.solution` (`T(x)`) by the Anderson-accelerated next iterate.
+    fn accelerate(&mut self, anderson: &mut AndersonAcceleration) {
+        let n = self.current.len();
+        for i in 0..n {
+            for c in 0..3 {
+                self.flat_x[3 * i + c] = self.current[i][c];
+                self.flat_g[3 * i + c] = self.solution[(i, c)];
+            }
+        }
+        anderson.next(&self.flat_x, &self.flat_g, &mut self.flat_next);
+        for i in 0..n {
+            for c in 0..3 {
+                self.solution[(i, c)] = self.flat_next[3 * i + c];
+            }
+        }
+    }
+
+    /// Section 5.3: rescale every triangle to its rest area and stitch (eq 13–15).
+    fn approximate_rigidity(&mut self, targets: &HandleTargets) -> Result<(), MethodError> {
+        let rest = self.rest.as_ref().expect("precomputed");
+        let bound = self.bound.as_mut().expect("bound");
+        let stitching = bound.stitching.as_mut().expect("built at bind for the ORA variant");
+        let rescaled = rescaled_triangles(&self.current, &rest.triangles, &rest.rest_areas);
+        let stitched = stitching.stitch(&rescaled, targets.positions());
+        for i in 0..self.current.len() {
+            self.solution[(i, 0)] = stitched[(i, 0)];
+            self.solution[(i, 1)] = stitched[(i, 1)];
+            self.solution[(i, 2)] = stitched[(i, 2)];
+        }
+        Ok(())
+    }
+}
+
+/// Largest distance between a row of `current` (`#V x 3`) and the same row of `next` (`#V x 3`).
+fn max_displacement_to(current: &[[f64; 3]], next: faer::MatRef<'_, f64>) -> f64 {
+    let mut d2: f64 = 0.0;
+    for (i, p) in current.iter().enumerate() {
+        let d = [next[(i, 0)] - p[0], next[(i, 1)] - p[1], next[(i, 2)] - p[2]];
+        d2 = d2.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    }
+    d2.sqrt()
+}
+
+impl DeformationMethod for ScaleAware {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn precompute(&mut self, rest_mesh: &TriMesh) -> Result<(), MethodError> {
+        let topology = Topology::new(rest_mesh)?;
+        let (positions, triangles) = (rest_mesh.positions(), rest_mesh.triangles());
+        let n = rest_mesh.n_vertices();
+        let measures = ScaleInvariantMeasures::new(positions, triangles, &topology);
+        let pyramids = NormalPyramids::new(positions, triangles, &measures.normals);
+        let equations = ScaleAwareEquations::new(n, triangles, measures);
+        self.recovery = Some(VertexRecovery::new(&equations)?);
+        self.initialization.precompute(rest_mesh)?;
+        self.rest = Some(RestState {
+            triangles: triangles.to_vec(),
+            equations,
+            pyramids,
+            rest_areas: face_areas(positions, triangles),
+            bbox_diagonal: rest_mesh.bbox_diagonal(),
+        });
+        self.current = positions.to_vec();
+        self.normals = vec![[0.0; 3]; triangles.len()];
+        let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        self.rotations = vec![identity; n];
+        self.frames = vec![identity; n];
+        self.rhs = Mat::zeros(3 * n, 1);
+        self.solution = Mat::zeros(n, 3);
+        self.flat_x = vec![0.0; 3 * n];
+        self.flat_g = vec![0.0; 3 * n];
+        self.flat_next = vec![0.0; 3 * n];
+        self.bound = None;
+        Ok(())
+    }
+
+    fn bind_handles(&mut self, handles: &HandleSet) -> Result<(), MethodError> {
+        let Some(rest) = &self.rest else {
+            return Err(MethodError::Phase {
+                method: self.name,
+                phase: "bind_handles",
+                missing: "precompute",
+            });
+        };
+        handles.check_mesh_size(self.current.len())?;
+        if handles.n_constrained() < 3 {
+            return Err(MethodError::Handles(format!(
+                "`{}` needs at least three constrained vertices (section 4); the set has {}",
+                self.name,
+                handles.n_constrained()
+            )));
+        }
+        self.initialization.bind_handles(handles)?;
+        let lambda = self.params.constraint_weight;
+        let mut constraint_diagonal = vec![0.0; 3 * self.current.len()];
+        for v in handles.constrained() {
+            constraint_diagonal[3 * v as usize..3 * v as usize + 3].fill(lambda);
+        }
+        let stitching = if self.params.optimal_rigidity {
+            let constrained: Vec<u32> = handles.constrained().collect();
+            Some(Stitching::new(self.current.len(), &rest.triangles, &constrained, lambda)?)
+        } else {
+            None
+        };
+        self.bound = Some(BoundState { handles: handles.clone(), constraint_diagonal, stitching });
+        Ok(())
+    }
+
+    fn solve(
+        &mut self,
+        targets: &HandleTargets,
+        observer: &mut dyn IterationObserver,
+    ) -> Result<SolveSummary, MethodError> {
+        if self.bound.is_none() {
+            return Err(MethodError::Phase { method: self.name, phase: "solve", missing: "bind_handles" });
+        }
+        self.timings = SolveTimings::default();
+        let diagonal = self.rest.as_ref().expect("bound implies precomputed").bbox_diagonal;
+
+        // Iteration 0: the initialization.
+        let start = Instant::now();
+        let before = self.current.clone();
+        self.initialize(targets)?;
+        self.timings.initialization = start.elapsed().as_secs_f64();
+        let step = max_displacement(&before, &self.current) / diagonal;
+        let report = IterationReport { iteration: 0, step, seconds: self.timings.initialization };
+        let current: &[[f64; 3]] = &self.current;
+        let mut summary = SolveSummary { iterations: 1, converged: false, final_step: step };
+        if observer.on_iteration(&report, &|| current.to_vec()) == ControlFlow::Break(()) {
+            return Ok(summary);
+        }
+
+        // Algorithm 1: x <- T(x), T = step two after step one, optionally Anderson-accelerated.
+        let mut anderson = AndersonAcceleration::new(self.params.anderson_depth, 3 * self.current.len());
+        for iteration in 1..=self.params.max_iterations {
+            let start = Instant::now();
+            self.update_normals();
+            self.timings.step_one_normals += start.elapsed().as_secs_f64();
+            self.recover_vertices(targets)?;
+            self.timings.outer_iterations += 1;
+            // The fixed-point residual |T(x) - x| is the plain iteration's step.
+            let residual = max_displacement_to(&self.current, self.solution.as_ref()) / diagonal;
+            if residual >= self.params.tolerance && self.params.anderson_depth > 0 {
+                self.accelerate(&mut anderson);
+            }
+            move_to(self.name, iteration, &mut self.current, self.solution.as_ref())?;
+            let stop;
+            (summary, stop) =
+                report_iteration(iteration, start, residual, &self.current, self.params.tolerance, observer);
+            if stop {
+                break;
+            }
+        }
+
+        if self.params.optimal_rigidity {
+            let start = Instant::now();
+            self.approximate_rigidity(targets)?;
+            self.timings.stitching = start.elapsed().as_secs_f64();
+            let iteration = summary.iterations;
+            // The stitching step is no convergence test: a tolerance of infinity never fails it.
+            let (done, _) = finish_iteration(
+                self.name,
+                iteration,
+                start,
+                &mut self.current,
+                self.solution.as_ref(),
+                diagonal,
+                f64::INFINITY,
+                observer,
+            )?;
+            summary = SolveSummary { iterations: done.iterations, converged: summary.converged, ..summary };
+        }
+        Ok(summary)
+    }
+
+    fn positions(&self) -> Vec<[f64; 3]> {
+        self.current.clone()
+    }
+
+    fn phase_timings(&self) -> Vec<(&'static str, f64)> {
+        let t = &self.timings;
+        let mut phases = vec![
+            ("initialization_laplacian", t.initialization),
+            ("step_one_normals", t.step_one_normals),
+            ("step_two_assembly", t.recovery.assembly_s),
+            ("step_two_refactorization", t.recovery.refactorization_s),
+            ("step_two_back_substitution", t.recovery.back_substitution_s),
+        ];
+        if self.params.optimal_rigidity {
+            phases.push(("ora_stitching", t.stitching));
+        }
+        phases
+    }
+
+    fn model_statistics(&self) -> Vec<(&'static str, f64)> {
+        vec![
+            ("outer_iterations", self.timings.outer_iterations as f64),
+            ("normal_iterations", self.timings.normal_iterations as f64),
+        ]
+    }
+}
