@@ -92,6 +92,13 @@ impl LaplacianEditing {
         })
     }
 
+    /// Make `positions` (`#V x 3`) the current shape, the start of the next solve (for methods that
+    /// use a Laplacian-editing step as their initialization).
+    pub(crate) fn set_current_shape(&mut self, positions: &[[f64; 3]]) {
+        self.current.clear();
+        self.current.extend_from_slice(positions);
+    }
+
     /// The current Laplacian coordinates `delta(X)` (`#V x 3`) into `self.delta`.
     fn update_delta(&mut self) {
         let rest = self.rest.as_mut().expect("precomputed");

@@ -13,6 +13,7 @@ pub mod operators;
 pub mod registry;
 pub mod rotation_fit;
 mod row_major;
+pub mod scale_aware;
 pub mod sparse_cholesky;
 pub mod spectral;
 pub mod spectral_mhb;

@@ -108,6 +108,18 @@ pub(crate) fn finish_iteration(
     tolerance: f64,
     observer: &mut dyn IterationObserver,
 ) -> Result<(SolveSummary, bool), crate::MethodError> {
+    let step = move_to(method, iteration, current, solution)? / diagonal;
+    Ok(report_iteration(iteration, start, step, current, tolerance, observer))
+}
+
+/// Move `current` (`#V x 3`) to `solution` (`#V x 3`) after checking that it is finite; returns the
+/// largest vertex displacement.
+pub(crate) fn move_to(
+    method: &'static str,
+    iteration: usize,
+    current: &mut [[f64; 3]],
+    solution: faer::MatRef<'_, f64>,
+) -> Result<f64, crate::MethodError> {
     let mut step2: f64 = 0.0;
     for (i, x) in current.iter_mut().enumerate() {
         let new = [solution[(i, 0)], solution[(i, 1)], solution[(i, 2)]];
@@ -118,10 +130,22 @@ pub(crate) fn finish_iteration(
         step2 = step2.max(meshes::vector::dot(d, d));
         *x = new;
     }
-    let step = step2.sqrt() / diagonal;
+    Ok(step2.sqrt())
+}
+
+/// Report iteration `iteration` with its (relative) `step` and the time since `start` to
+/// `observer`; returns the summary so far and whether to stop (`step < tolerance`, or the observer
+/// asked).
+pub(crate) fn report_iteration(
+    iteration: usize,
+    start: std::time::Instant,
+    step: f64,
+    current: &[[f64; 3]],
+    tolerance: f64,
+    observer: &mut dyn IterationObserver,
+) -> (SolveSummary, bool) {
     let report = IterationReport { iteration, step, seconds: start.elapsed().as_secs_f64() };
     let summary = SolveSummary { iterations: iteration + 1, converged: step < tolerance, final_step: step };
-    let current: &[[f64; 3]] = current;
     let flow = observer.on_iteration(&report, &|| current.to_vec());
-    Ok((summary, summary.converged || flow == ControlFlow::Break(())))
+    (summary, summary.converged || flow == ControlFlow::Break(()))
 }

@@ -8,6 +8,7 @@ use crate::hirm::Hirm;
 use crate::isolines::Isolines;
 use crate::laplacian::LaplacianEditing;
 use crate::method::DeformationMethod;
+use crate::scale_aware::ScaleAware;
 use crate::spectral_mhb::SpectralMhb;
 
 /// One registered method.
@@ -41,6 +42,16 @@ pub const METHODS: &[MethodEntry] = &[
         name: "spectral_mhb",
         summary: "spectral mesh deformation in manifold harmonics bases with deformation transfer of details (Rong, Cao & Guo 2008)",
         create: |p| Ok(Box::new(SpectralMhb::new(parse("spectral_mhb", p)?)?)),
+    },
+    MethodEntry {
+        name: "scale_aware",
+        summary: "scale-aware shape manipulation: triangle and edge angles, normals on the Gauss map, then G(Theta, N) V = 0 (Liu, Wang, Liu & Liu)",
+        create: |p| Ok(Box::new(ScaleAware::new("scale_aware", parse("scale_aware", p)?)?)),
+    },
+    MethodEntry {
+        name: "scale_aware_ora",
+        summary: "`scale_aware` followed by the optimal rigidity approximation: triangles rescaled to their rest areas and stitched (section 5.3)",
+        create: |p| Ok(Box::new(ScaleAware::new("scale_aware_ora", parse("scale_aware_ora", p)?)?)),
     },
     MethodEntry {
         name: "isolines",

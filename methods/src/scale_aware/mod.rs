@@ -29,6 +29,17 @@
 //!   the similarity of `G` undetermined.
 //! - Every solve starts from the Laplacian initialization of the current shape, so a second edit
 //!   step is handled like the first.
+//! - Acceleration. Algorithm 1 converges linearly and slowly: on the survey cactus the largest step
+//!   is still 1e-3 of the diagonal after 50 plain outer iterations (E_phi 0.49 deg, 0.43 after
+//!   300). The outer iteration is therefore Anderson-accelerated ([`anderson`], depth 5 by default;
+//!   `anderson_depth = 0` is the plain iteration). It does not change the fixed points, and the
+//!   convergence test uses the fixed-point residual `|T(x) - x|`, which is the plain step.
+//! - Step one's inner loop rarely meets `normal_tolerance` within `normal_iterations`: the smooth
+//!   rotation of the Gauss map that carries the bend is its slowest mode, and the outer iteration
+//!   depends on it not converging (fully converged, step one would rotate the rest normals
+//!   rigidly). Measured on the cactus, 10 inner iterations end at E_phi 0.55 deg, 20 at 0.49 and 60
+//!   at 0.44 after 50 outer iterations, with slower outer convergence the more inner iterations;
+//!   20 is the paper's upper figure and the default.
 
 pub mod anderson;
 pub mod gauss_map;
