@@ -93,6 +93,23 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
     assert_eq!(cases.len(), rows.len());
     assert!(cases.iter().all(|c| !c["trace"].as_array().unwrap().is_empty()));
 
+    // Per-iteration angle errors (the scale-aware paper's Fig. 6): Algorithm 1 ends well below its
+    // Laplacian initialization (iteration 0) on the cactus.
+    let convergence = csv_rows(&reports.path().join("convergence.csv"));
+    for method in ["scale_aware", "scale_aware_ora"] {
+        let curve: Vec<_> =
+            convergence.iter().filter(|r| r["scenario"] == "cactus" && r["method"] == method).collect();
+        assert!(curve.len() >= 3, "cactus/{method}: {} iterations in convergence.csv", curve.len());
+        assert!(curve.iter().all(|r| !r["e_theta_deg"].is_empty() && !r["e_phi_deg"].is_empty()));
+        for key in ["e_theta_deg", "e_phi_deg"] {
+            let (first, last) = (num(curve[0], key), num(curve[curve.len() - 1], key));
+            assert!(
+                last < 0.5 * first,
+                "cactus/{method}: {key} {first} at the initialization, {last} at the end"
+            );
+        }
+    }
+
     // Incremental editing (HIRM section 4.5): every method runs both steps; the second adds a handle.
     let updates = csv_rows(&reports.path().join("handle_updates.csv"));
     for scenario in ["bar-incremental", "cactus-incremental"] {

@@ -12,9 +12,22 @@ use crate::scenario::LoadedScenario;
 /// One iteration as recorded for convergence curves.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct IterationRecord {
+    /// 1-based edit step of the scenario.
+    pub edit_step: usize,
+    /// 0-based within the edit step.
     pub iteration: usize,
     pub step: f64,
     pub seconds: f64,
+    /// `E_theta` / `E_phi` (degrees) of the iterate, on the iterations [`records_quality`] selects.
+    pub e_theta_deg: Option<f64>,
+    pub e_phi_deg: Option<f64>,
+}
+
+/// Whether the angle errors of iteration `i` (0-based, within a step) are recorded: every one of
+/// the first 100, then every 10th. Evaluating them costs a full-mesh reconstruction, which would
+/// dominate the long traces of the unreduced methods.
+pub fn records_quality(i: usize) -> bool {
+    i < 100 || i % 10 == 0
 }
 
 /// One edit step of a case: a handle set bound and solved for.
@@ -71,11 +84,36 @@ pub struct CaseResult {
     pub positions: Option<Vec<[f64; 3]>>,
 }
 
-struct Recorder(Vec<IterationRecord>);
+/// Records every iteration, with the angle errors of the iterate where [`records_quality`] says so.
+struct Recorder<'a> {
+    scenario: &'a LoadedScenario,
+    rest_angles: &'a RestAngles,
+    trace: Vec<IterationRecord>,
+    /// 1-based edit step being solved.
+    edit_step: usize,
+    /// Wall time spent evaluating the angle errors, excluded from the reported solve times.
+    quality_s: f64,
+}
 
-impl IterationObserver for Recorder {
-    fn on_iteration(&mut self, r: &IterationReport, _: &dyn Fn() -> Vec<[f64; 3]>) -> ControlFlow<()> {
-        self.0.push(IterationRecord { iteration: r.iteration, step: r.step, seconds: r.seconds });
+impl IterationObserver for Recorder<'_> {
+    fn on_iteration(&mut self, r: &IterationReport, shape: &dyn Fn() -> Vec<[f64; 3]>) -> ControlFlow<()> {
+        let mut record = IterationRecord {
+            edit_step: self.edit_step,
+            iteration: r.iteration,
+            step: r.step,
+            seconds: r.seconds,
+            e_theta_deg: None,
+            e_phi_deg: None,
+        };
+        if records_quality(r.iteration) {
+            let t = Instant::now();
+            let (e_theta, e_phi) =
+                angle_errors(self.rest_angles, &self.scenario.mesh, &self.scenario.topology, &shape());
+            record.e_theta_deg = Some(e_theta);
+            record.e_phi_deg = Some(e_phi);
+            self.quality_s += t.elapsed().as_secs_f64();
+        }
+        self.trace.push(record);
         ControlFlow::Continue(())
     }
 }
@@ -112,7 +150,7 @@ pub fn run_case(
         trace: Vec::new(),
         positions: None,
     };
-    let mut recorder = Recorder(Vec::new());
+    let mut recorder = Recorder { scenario, rest_angles, trace: Vec::new(), edit_step: 0, quality_s: 0.0 };
     let outcome = (|| -> Result<(), methods::MethodError> {
         let mut m = methods::registry::create(method, params)?;
         let start = Instant::now();
@@ -125,10 +163,12 @@ pub fn run_case(
             let t = Instant::now();
             m.bind_handles(&step.handles)?;
             let bind_s = t.elapsed().as_secs_f64();
-            let first_iteration = recorder.0.len();
+            let first_iteration = recorder.trace.len();
+            recorder.edit_step = i + 1;
+            let quality_before = recorder.quality_s;
             let t = Instant::now();
             let summary = m.solve(&targets, &mut recorder)?;
-            let step_solve_s = t.elapsed().as_secs_f64();
+            let step_solve_s = t.elapsed().as_secs_f64() - (recorder.quality_s - quality_before);
             solve_s += step_solve_s;
             result.iterations += summary.iterations;
             result.steps.push(StepRecord {
@@ -139,7 +179,7 @@ pub fn run_case(
                 solve_s: step_solve_s,
                 iterations: summary.iterations,
                 converged: summary.converged,
-                median_iteration_ms: median_ms(&recorder.0[first_iteration..]),
+                median_iteration_ms: median_ms(&recorder.trace[first_iteration..]),
                 phase_timings: m.phase_timings().into_iter().map(|(k, v)| (k.to_string(), v)).collect(),
             });
             final_edit = Some((step, targets));
@@ -148,7 +188,7 @@ pub fn run_case(
         let positions = m.positions();
         result.bind_s = result.steps.first().map_or(f64::NAN, |s| s.bind_s);
         result.solve_s = solve_s;
-        result.total_s = start.elapsed().as_secs_f64();
+        result.total_s = start.elapsed().as_secs_f64() - recorder.quality_s;
         result.phase_timings = m.phase_timings().into_iter().map(|(k, v)| (k.to_string(), v)).collect();
         result.statistics = m.model_statistics().into_iter().map(|(k, v)| (k.to_string(), v)).collect();
         let (step, targets) = final_edit.expect("a scenario has at least one step");
@@ -167,8 +207,8 @@ pub fn run_case(
         result.positions = Some(positions);
         Ok(())
     })();
-    result.median_iteration_ms = median_ms(&recorder.0);
-    result.trace = recorder.0;
+    result.median_iteration_ms = median_ms(&recorder.trace);
+    result.trace = recorder.trace;
     result.status = match outcome {
         Ok(()) => "ok".into(),
         Err(e) => format!("failed: {e}"),

@@ -1,4 +1,5 @@
-//! Writing reports: `results.csv`, `results.json` and the result meshes (OFF and GLB) of every case.
+//! Writing reports: `results.csv`, `results.json`, `convergence.csv`, the handle-update tables and
+//! the result meshes (OFF and GLB) of every case.
 //! Everything is rendered in memory first and each file is written atomically, so a failed run leaves
 //! the previous reports intact.
 
@@ -39,12 +40,20 @@ struct JsonReport<'a> {
     cases: &'a [CaseResult],
 }
 
+/// A CSV number: empty for NaN (a missing value), else 7 significant digits.
+fn num(v: f64) -> String {
+    if v.is_nan() {
+        String::new()
+    } else {
+        format!("{v:.6e}")
+    }
+}
+
 /// `results.csv` contents.
 pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let err = |e: csv::Error| HarnessError::Report(format!("CSV: {e}"));
     w.write_record(CSV_COLUMNS).map_err(err)?;
-    let num = |v: f64| if v.is_nan() { String::new() } else { format!("{v:.6e}") };
     for r in results {
         w.write_record([
             r.scenario.clone(),
@@ -174,7 +183,44 @@ pub fn render_table1(results: &[CaseResult]) -> String {
     out
 }
 
-/// Write `results.csv`, `results.json` and `meshes/<scenario>-<method>.{off,glb}` under `dir`.
+/// `convergence.csv` contents: one row per iteration of every case (the scale-aware paper's Fig. 6
+/// curves), with the angle errors where the harness evaluated them (see
+/// [`crate::case::records_quality`]; empty otherwise).
+pub fn render_convergence(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let err = |e: csv::Error| HarnessError::Report(format!("CSV: {e}"));
+    w.write_record([
+        "scenario",
+        "method",
+        "edit_step",
+        "iteration",
+        "step",
+        "seconds",
+        "e_theta_deg",
+        "e_phi_deg",
+    ])
+    .map_err(err)?;
+    let opt = |v: Option<f64>| v.map(num).unwrap_or_default();
+    for r in results {
+        for t in &r.trace {
+            w.write_record([
+                r.scenario.clone(),
+                r.method.clone(),
+                t.edit_step.to_string(),
+                t.iteration.to_string(),
+                num(t.step),
+                num(t.seconds),
+                opt(t.e_theta_deg),
+                opt(t.e_phi_deg),
+            ])
+            .map_err(err)?;
+        }
+    }
+    w.into_inner().map_err(|e| HarnessError::Report(format!("CSV: {e}")))
+}
+
+/// Write `results.csv`, `results.json`, `convergence.csv`, `handle_updates.csv`, `table1.md` and
+/// `meshes/<scenario>-<method>.{off,glb}` under `dir`.
 pub fn write_reports(
     dir: &Path,
     results: &[CaseResult],
@@ -196,6 +242,7 @@ pub fn write_reports(
         meshes::io::write_off(mesh_dir.join(format!("{stem}.off")), &mesh)?;
         meshes::io::write_glb(mesh_dir.join(format!("{stem}.glb")), &mesh, None)?;
     }
+    write_bytes(&dir.join("convergence.csv"), &render_convergence(results)?)?;
     write_bytes(&dir.join("handle_updates.csv"), &render_handle_updates(results)?)?;
     write_bytes(&dir.join("table1.md"), render_table1(results).as_bytes())?;
     write_bytes(&dir.join("results.json"), &json)?;
