@@ -1,0 +1,501 @@
+//! Plots of a run (plotters; every plot as PNG and SVG under `plots/`):
+//! - `<scenario>-errors`: grouped bars of `E_theta` and `E_phi` per method;
+//! - `<scenario>-timings`: stacked precompute / handle bind / solve time per method;
+//! - `<scenario>-convergence`: step size, `E_theta` and `E_phi` per iteration, one line per method
+//!   (the scale-aware paper's Fig. 6);
+//! - `scaling`: log-log per-iteration time against vertex count over the resolution sweeps
+//!   (scenarios named `*-sweep-*`), one line per method;
+//! - `table1`: HIRM's Table 1 as a chart, handle-set update time against the number of handles,
+//!   `hirm`'s `t_h` and the `isolines` rebuild, per `*-handles` scenario.
+//!
+//! Every file is drawn to a temporary name and renamed when complete, so a failure leaves no
+//! half-written plot.
+
+use std::path::{Path, PathBuf};
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::case::CaseResult;
+use crate::error::HarnessError;
+
+/// Pixel size of every plot.
+const SIZE: (u32, u32) = (960, 540);
+
+/// Method colours, fixed by registry order so a method has the same colour in every plot.
+fn method_color(method: &str) -> RGBColor {
+    const PALETTE: [RGBColor; 10] = [
+        RGBColor(31, 119, 180),
+        RGBColor(255, 127, 14),
+        RGBColor(44, 160, 44),
+        RGBColor(214, 39, 40),
+        RGBColor(148, 103, 189),
+        RGBColor(140, 86, 75),
+        RGBColor(227, 119, 194),
+        RGBColor(127, 127, 127),
+        RGBColor(188, 189, 34),
+        RGBColor(23, 190, 207),
+    ];
+    let index = methods::registry::method_names().iter().position(|m| *m == method).unwrap_or(0);
+    PALETTE[index % PALETTE.len()]
+}
+
+/// Write every plot of `results` under `dir/plots/`; returns the paths written relative to `dir`
+/// (PNG and SVG of each plot).
+pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, HarnessError> {
+    crate::fonts::register_sans_serif()?;
+    let plot_dir = dir.join("plots");
+    std::fs::create_dir_all(&plot_dir).map_err(|error| HarnessError::Io { path: plot_dir.clone(), error })?;
+    let mut written = Vec::new();
+    let mut scenarios: Vec<&str> = Vec::new();
+    for r in results {
+        if !scenarios.contains(&r.scenario.as_str()) {
+            scenarios.push(&r.scenario);
+        }
+    }
+    for scenario in scenarios {
+        let cases: Vec<&CaseResult> = results.iter().filter(|r| r.scenario == scenario).collect();
+        written.extend(save(dir, &format!("{scenario}-errors"), &Plot::Errors(scenario, &cases))?);
+        written.extend(save(dir, &format!("{scenario}-timings"), &Plot::Timings(scenario, &cases))?);
+        written.extend(save(dir, &format!("{scenario}-convergence"), &Plot::Convergence(scenario, &cases))?);
+    }
+    let sweeps: Vec<&CaseResult> =
+        results.iter().filter(|r| r.scenario.contains("-sweep-") && r.status == "ok").collect();
+    if !sweeps.is_empty() {
+        written.extend(save(dir, "scaling", &Plot::Scaling(&sweeps))?);
+    }
+    let handle_scenarios: Vec<&CaseResult> = results
+        .iter()
+        .filter(|r| r.scenario.ends_with("-handles") && (r.method == "hirm" || r.method == "isolines"))
+        .collect();
+    if !handle_scenarios.is_empty() {
+        written.extend(save(dir, "table1", &Plot::Table1(&handle_scenarios))?);
+    }
+    Ok(written)
+}
+
+type Area<'a, DB> = DrawingArea<DB, Shift>;
+type DrawResult = Result<(), String>;
+
+/// One plot and its data, drawable on any plotters backend.
+enum Plot<'a> {
+    Errors(&'a str, &'a [&'a CaseResult]),
+    Timings(&'a str, &'a [&'a CaseResult]),
+    Convergence(&'a str, &'a [&'a CaseResult]),
+    Scaling(&'a [&'a CaseResult]),
+    Table1(&'a [&'a CaseResult]),
+}
+
+impl Plot<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: Area<'_, DB>) -> DrawResult {
+        match self {
+            Plot::Errors(scenario, cases) => draw_errors(root, scenario, cases),
+            Plot::Timings(scenario, cases) => draw_timings(root, scenario, cases),
+            Plot::Convergence(scenario, cases) => draw_convergence(root, scenario, cases),
+            Plot::Scaling(cases) => draw_scaling(root, cases),
+            Plot::Table1(cases) => draw_table1(root, cases),
+        }
+    }
+}
+
+/// Draw `plot` into `plots/<stem>.png` and `.svg` under `dir`; returns both relative paths.
+fn save(dir: &Path, stem: &str, plot: &Plot<'_>) -> Result<Vec<PathBuf>, HarnessError> {
+    let png = PathBuf::from("plots").join(format!("{stem}.png"));
+    let svg = PathBuf::from("plots").join(format!("{stem}.svg"));
+    let fail = |path: &Path, message: String| HarnessError::Report(format!("{}: {message}", path.display()));
+
+    let final_png = dir.join(&png);
+    // The bitmap backend picks the encoder from the extension, so the temporary name ends in .png.
+    let temporary = dir.join(format!("plots/.{stem}.partial.png"));
+    {
+        let root = BitMapBackend::new(&temporary, SIZE).into_drawing_area();
+        plot.draw(root.clone()).map_err(|m| fail(&final_png, m))?;
+        root.present().map_err(|e| fail(&final_png, e.to_string()))?;
+    }
+    std::fs::rename(&temporary, &final_png)
+        .map_err(|error| HarnessError::Io { path: final_png.clone(), error })?;
+
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
+        plot.draw(root.clone()).map_err(|m| fail(&dir.join(&svg), m))?;
+        root.present().map_err(|e| fail(&dir.join(&svg), e.to_string()))?;
+    }
+    let final_svg = dir.join(&svg);
+    meshes::io::atomic_write(&final_svg, |w| w.write_all(text.as_bytes()).map_err(meshes::MeshError::from))?;
+    Ok(vec![png, svg])
+}
+
+fn err<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+/// The method names under the bars of a category chart (category `i` spans `i..i + 1` on x),
+/// drawn on `root` below the x axis.
+fn label_categories<DB: DrawingBackend>(
+    root: &Area<'_, DB>,
+    chart: &ChartContext<
+        '_,
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    cases: &[&CaseResult],
+) -> DrawResult {
+    let style = TextStyle::from(("sans-serif", 13).into_font()).pos(plotters::style::text_anchor::Pos::new(
+        plotters::style::text_anchor::HPos::Center,
+        plotters::style::text_anchor::VPos::Top,
+    ));
+    for (i, c) in cases.iter().enumerate() {
+        let (x, y) = chart.backend_coord(&(i as f64 + 0.5, 0.0));
+        root.draw(&Text::new(c.method.clone(), (x, y + 8), style.clone())).map_err(err)?;
+    }
+    Ok(())
+}
+
+/// Grouped bars: per method, `E_theta` (solid) and `E_phi` (lighter), degrees.
+fn draw_errors<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &[&CaseResult]) -> DrawResult {
+    root.fill(&WHITE).map_err(err)?;
+    let ok: Vec<&&CaseResult> =
+        cases.iter().filter(|c| c.e_theta_deg.is_finite() && c.e_phi_deg.is_finite()).collect();
+    let top = ok.iter().map(|c| c.e_theta_deg.max(c.e_phi_deg)).fold(0.0, f64::max).max(1e-3) * 1.15;
+    let n = cases.len().max(1);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("{scenario}: angle errors (degrees; lower is better)"), ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(70)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..n as f64, 0.0..top)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(0)
+        .y_desc("degrees")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    label_categories(&root, &chart, cases)?;
+    for (i, c) in cases.iter().enumerate() {
+        let color = method_color(&c.method);
+        let x = i as f64;
+        for (k, value, style) in
+            [(0, c.e_theta_deg, color.filled()), (1, c.e_phi_deg, color.mix(0.45).filled())]
+        {
+            if !value.is_finite() {
+                continue;
+            }
+            let x0 = x + 0.12 + 0.38 * k as f64;
+            chart
+                .draw_series(std::iter::once(Rectangle::new([(x0, 0.0), (x0 + 0.36, value)], style)))
+                .map_err(err)?;
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    format!("{value:.2}"),
+                    (x0 + 0.02, value + 0.02 * top),
+                    ("sans-serif", 12),
+                )))
+                .map_err(err)?;
+        }
+    }
+    // Legend for the two bar kinds.
+    let grey = RGBColor(90, 90, 90);
+    for (k, label, style) in
+        [(0, "E_θ (corner angles)", grey.filled()), (1, "E_φ (dihedral angles)", grey.mix(0.45).filled())]
+    {
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [
+                    (0.05 * n as f64, top * (0.95 - 0.06 * k as f64)),
+                    (0.08 * n as f64, top * (0.92 - 0.06 * k as f64)),
+                ],
+                style,
+            )))
+            .map_err(err)?;
+        chart
+            .draw_series(std::iter::once(Text::new(
+                label,
+                (0.09 * n as f64, top * (0.955 - 0.06 * k as f64)),
+                ("sans-serif", 14),
+            )))
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
+/// Stacked bars: precompute, handle bind (all steps) and solve (all steps) per method, seconds.
+fn draw_timings<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &[&CaseResult]) -> DrawResult {
+    root.fill(&WHITE).map_err(err)?;
+    let parts = |c: &CaseResult| {
+        let bind: f64 = c.steps.iter().map(|s| s.bind_s).sum();
+        [c.precompute_s, bind, c.solve_s].map(|v| if v.is_finite() { v } else { 0.0 })
+    };
+    let top = cases.iter().map(|c| parts(c).iter().sum::<f64>()).fold(0.0, f64::max).max(1e-3) * 1.12;
+    let n = cases.len().max(1);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("{scenario}: time per phase (seconds)"), ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(70)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..n as f64, 0.0..top)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(0)
+        .y_desc("seconds")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    label_categories(&root, &chart, cases)?;
+    let phase_colors = [RGBColor(120, 120, 200), RGBColor(230, 160, 60), RGBColor(90, 170, 90)];
+    for (i, c) in cases.iter().enumerate() {
+        let mut bottom = 0.0;
+        for (value, color) in parts(c).iter().zip(phase_colors) {
+            let x = i as f64;
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(x + 0.2, bottom), (x + 0.8, bottom + value)],
+                    color.filled(),
+                )))
+                .map_err(err)?;
+            bottom += value;
+        }
+        chart
+            .draw_series(std::iter::once(Text::new(
+                format!("{bottom:.3}"),
+                (i as f64 + 0.25, bottom + 0.015 * top),
+                ("sans-serif", 12),
+            )))
+            .map_err(err)?;
+    }
+    for (k, (label, color)) in
+        ["precompute", "handle bind", "solve (iterations)"].iter().zip(phase_colors).enumerate()
+    {
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [
+                    (0.05 * n as f64, top * (0.95 - 0.06 * k as f64)),
+                    (0.08 * n as f64, top * (0.92 - 0.06 * k as f64)),
+                ],
+                color.filled(),
+            )))
+            .map_err(err)?;
+        chart
+            .draw_series(std::iter::once(Text::new(
+                *label,
+                (0.09 * n as f64, top * (0.955 - 0.06 * k as f64)),
+                ("sans-serif", 14),
+            )))
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
+/// Three panels over the iterations of every method (all edit steps in sequence): step size
+/// (log), `E_theta` and `E_phi` (degrees, where recorded).
+fn draw_convergence<DB: DrawingBackend>(
+    root: Area<'_, DB>,
+    scenario: &str,
+    cases: &[&CaseResult],
+) -> DrawResult {
+    root.fill(&WHITE).map_err(err)?;
+    let root =
+        root.titled(&format!("{scenario}: convergence per iteration"), ("sans-serif", 22)).map_err(err)?;
+    let panels = root.split_evenly((1, 3));
+    // Log x axis over iteration + 1: the unreduced methods take 1000+ iterations, the reduced ones
+    // and scale_aware tens, and both ends must be readable.
+    let max_iter = cases.iter().map(|c| c.trace.len()).max().unwrap_or(1).max(2) as f64 + 1.0;
+    type Series = fn(&crate::case::IterationRecord) -> Option<f64>;
+    let specs: [(&str, Series, bool); 3] = [
+        ("step / diagonal", |t| Some(t.step), true),
+        ("E_θ (degrees)", |t| t.e_theta_deg, false),
+        ("E_φ (degrees)", |t| t.e_phi_deg, false),
+    ];
+    for (panel, (label, value, log)) in panels.iter().zip(specs) {
+        let points = |c: &CaseResult| -> Vec<(f64, f64)> {
+            c.trace
+                .iter()
+                .enumerate()
+                .filter_map(|(i, t)| value(t).map(|v| (i as f64 + 1.0, v)))
+                .filter(|(_, v)| v.is_finite() && (!log || *v > 0.0))
+                .collect()
+        };
+        let all: Vec<f64> = cases.iter().flat_map(|c| points(c)).map(|(_, v)| v).collect();
+        let (lo, hi) = all.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+        let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (1e-6, 1.0) };
+        let mut builder = ChartBuilder::on(panel);
+        builder.margin(8).x_label_area_size(36).y_label_area_size(56);
+        if log {
+            let mut chart = builder
+                .build_cartesian_2d((1.0..max_iter).log_scale(), (lo.max(1e-16) * 0.8..hi * 1.25).log_scale())
+                .map_err(err)?;
+            chart
+                .configure_mesh()
+                .x_desc("iteration + 1")
+                .y_desc(label)
+                .label_style(("sans-serif", 12))
+                .draw()
+                .map_err(err)?;
+            for c in cases {
+                let color = method_color(&c.method);
+                chart
+                    .draw_series(LineSeries::new(points(c), color.stroke_width(2)))
+                    .map_err(err)?
+                    .label(c.method.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+            }
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::LowerLeft)
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 12))
+                .draw()
+                .map_err(err)?;
+        } else {
+            let span = (hi - lo).max(1e-9);
+            let mut chart = builder
+                .build_cartesian_2d(
+                    (1.0..max_iter).log_scale(),
+                    (lo - 0.05 * span).max(0.0)..hi + 0.05 * span,
+                )
+                .map_err(err)?;
+            chart
+                .configure_mesh()
+                .x_desc("iteration + 1")
+                .y_desc(label)
+                .label_style(("sans-serif", 12))
+                .draw()
+                .map_err(err)?;
+            for c in cases {
+                chart
+                    .draw_series(LineSeries::new(points(c), method_color(&c.method).stroke_width(2)))
+                    .map_err(err)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Log-log median iteration time against vertex count, one line per method.
+fn draw_scaling<DB: DrawingBackend>(root: Area<'_, DB>, sweeps: &[&CaseResult]) -> DrawResult {
+    root.fill(&WHITE).map_err(err)?;
+    let mut methods: Vec<&str> = Vec::new();
+    for r in sweeps {
+        if !methods.contains(&r.method.as_str()) {
+            methods.push(&r.method);
+        }
+    }
+    let line = |m: &str| -> Vec<(f64, f64)> {
+        let mut points: Vec<(f64, f64)> = sweeps
+            .iter()
+            .filter(|r| r.method == m && r.median_iteration_ms > 0.0 && r.median_iteration_ms.is_finite())
+            .map(|r| (r.vertices as f64, r.median_iteration_ms))
+            .collect();
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        points
+    };
+    let all: Vec<(f64, f64)> = methods.iter().flat_map(|m| line(m)).collect();
+    let (x0, x1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let (y0, y1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    if !x0.is_finite() {
+        return Ok(());
+    }
+    let mut chart = ChartBuilder::on(&root)
+        .caption("Per-iteration time against mesh size (resolution sweep)", ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x0 * 0.7..x1 * 1.4).log_scale(), (y0 * 0.5..y1 * 2.0).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("vertices")
+        .y_desc("median iteration (ms)")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    for m in methods {
+        let color = method_color(m);
+        let points = line(m);
+        chart
+            .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
+            .map_err(err)?
+            .label(m.to_string())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+        chart.draw_series(points.into_iter().map(|p| Circle::new(p, 4, color.filled()))).map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// Handle-set update time against the number of handles: `hirm`'s `t_h` and the `isolines`
+/// rebuild (its whole bind), one line each per `*-handles` scenario (log time axis).
+fn draw_table1<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult]) -> DrawResult {
+    root.fill(&WHITE).map_err(err)?;
+    let series = |c: &CaseResult| -> Vec<(f64, f64)> {
+        c.steps
+            .iter()
+            .filter_map(|s| {
+                let seconds = if c.method == "hirm" {
+                    s.phase_timings.iter().find(|(k, _)| k == "t_h_handle_update").map(|(_, v)| *v)?
+                } else {
+                    s.bind_s
+                };
+                (seconds > 0.0 && seconds.is_finite()).then_some((s.handles as f64, 1e3 * seconds))
+            })
+            .collect()
+    };
+    let all: Vec<(f64, f64)> = cases.iter().flat_map(|c| series(c)).collect();
+    if all.is_empty() {
+        return Ok(());
+    }
+    let x1 = all.iter().map(|p| p.0).fold(0.0, f64::max);
+    let (y0, y1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "Handle-set update: hirm t_h against the isolines rebuild (HIRM Table 1)",
+            ("sans-serif", 20),
+        )
+        .margin(12)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..x1 + 1.0, (y0 * 0.5..y1 * 2.0).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("handles (fixed region included)")
+        .y_desc("update time (ms)")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    for c in cases {
+        let color = method_color(&c.method);
+        let dashed = c.scenario.starts_with("cactus");
+        let label = format!("{} ({})", c.method, c.scenario);
+        let points = series(c);
+        let style = color.stroke_width(if dashed { 1 } else { 3 });
+        chart
+            .draw_series(LineSeries::new(points.clone(), style))
+            .map_err(err)?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
+        chart.draw_series(points.into_iter().map(|p| Circle::new(p, 4, color.filled()))).map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
