@@ -1,0 +1,629 @@
+//! The report figures: a shaded render and an angle-error heat map of every result, and the two
+//! grids (rows = scenarios, columns = `rest` + methods) the survey and the scale-aware paper
+//! (Fig. 10) present results in.
+//!
+//! Rows are the scenarios of `scenarios` (in that order) with at least one result; a result whose
+//! scenario is not among them has no rest mesh to render and is left out. Columns are the same for
+//! every row: every method with a result, in registry order (unknown names after, in order of first
+//! appearance), so a method stays in one column; a scenario that did not run a method gets a
+//! `not run` cell there, a failed case (status not `ok`, or no `#V x 3` positions) a `failed` cell.
+
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+
+use crate::case::CaseResult;
+use crate::error::HarnessError;
+use crate::scenario::LoadedScenario;
+
+use super::camera::{Camera, VIEW_FROM};
+use super::canvas::RgbImage;
+use super::heat::{heat_color, vertex_angle_errors, HEAT_MAX_DEG};
+use super::shade::{render, Paint, VertexRole};
+use super::text::{draw_labels, Align, Label};
+
+/// Side of a rendered cell, in pixels (each figure is one square cell).
+pub const CELL_SIZE: u32 = 320;
+
+/// Grid geometry, in pixels.
+const PAD: u32 = 20;
+const HEADER_H: u32 = 50;
+const CAPTION_H: u32 = 40;
+const ROW_GAP: u32 = 14;
+/// Height of the legend above the notes, and of a line of notes.
+const LEGEND_H: [u32; 2] = [44, 84];
+const NOTE_LINE_H: u32 = 24;
+
+/// Font sizes, in pixels: column and row names, row details and notes, cell captions, legends.
+const NAME_PX: f64 = 26.0;
+const DETAIL_PX: f64 = 17.0;
+const CAPTION_PX: f64 = 20.0;
+const LEGEND_PX: f64 = 19.0;
+const TICK_PX: f64 = 16.0;
+
+const INK: [u8; 3] = [25, 25, 25];
+const MUTED: [u8; 3] = [110, 110, 110];
+const FAINT: [u8; 3] = [175, 175, 175];
+const RULE: [u8; 3] = [222, 222, 222];
+const EMPTY_CELL: [u8; 3] = [247, 247, 247];
+const FAILED_CELL: [u8; 3] = [250, 238, 238];
+const FAILED_INK: [u8; 3] = [170, 50, 50];
+
+/// Folder of the figures under the report directory.
+const FIGURES: &str = "figures";
+
+/// Write `figures/<scenario>-rest.png`, `figures/<scenario>-<method>.png`,
+/// `figures/<scenario>-<method>-heat.png`, `figures/grid.png`, `figures/grid_heat.png` under `dir`;
+/// returns the paths written, relative to `dir` (for the HTML report).
+///
+/// `results` are the cases of the run (a result's `positions` are its final `#V x 3` shape on the
+/// rest connectivity of its scenario); `scenarios` give the rest meshes and the handle sets (the
+/// last step's: the region named `fixed` is drawn blue, every other region orange). Scenario and
+/// method names are used in file names with characters other than ASCII letters, digits, `-`, `_`
+/// and `.` replaced by `_`. Each file is written atomically.
+///
+/// Errors: no font for the labels ([`crate::fonts::register_sans_serif`]), or a file that cannot be
+/// encoded or written (the error names it).
+pub fn write_figures(
+    dir: &Path,
+    results: &[CaseResult],
+    scenarios: &[LoadedScenario],
+) -> Result<Vec<PathBuf>, HarnessError> {
+    crate::fonts::register_sans_serif()?;
+    let columns = method_columns(results);
+    let rows: Vec<Row> = scenarios
+        .iter()
+        .filter(|s| results.iter().any(|r| r.scenario == s.spec.name))
+        .map(|scenario| Row {
+            scenario,
+            cases: columns
+                .iter()
+                .map(|m| results.iter().find(|r| r.scenario == scenario.spec.name && &r.method == m))
+                .collect(),
+        })
+        .collect();
+    let rendered: Vec<RenderedRow> = rows.par_iter().map(render_row).collect();
+
+    let figures = dir.join(FIGURES);
+    std::fs::create_dir_all(&figures).map_err(|error| HarnessError::Io { path: figures.clone(), error })?;
+    let mut files: Vec<(PathBuf, &RgbImage)> = Vec::new();
+    for (row, images) in rows.iter().zip(&rendered) {
+        let stem = file_name(&row.scenario.spec.name);
+        files.push((Path::new(FIGURES).join(format!("{stem}-rest.png")), &images.rest));
+        for (case, cell) in row.cases.iter().zip(&images.cells) {
+            if let (Some(case), Cell::Rendered { shaded, heat }) = (case, cell) {
+                let stem = format!("{stem}-{}", file_name(&case.method));
+                files.push((Path::new(FIGURES).join(format!("{stem}.png")), shaded));
+                files.push((Path::new(FIGURES).join(format!("{stem}-heat.png")), heat));
+            }
+        }
+    }
+    let grid = grid_image(&rows, &rendered, &columns, Kind::Shaded)
+        .map_err(|e| HarnessError::Report(format!("{}: {e}", figures.join("grid.png").display())))?;
+    let grid_heat = grid_image(&rows, &rendered, &columns, Kind::Heat)
+        .map_err(|e| HarnessError::Report(format!("{}: {e}", figures.join("grid_heat.png").display())))?;
+    files.push((Path::new(FIGURES).join("grid.png"), &grid));
+    files.push((Path::new(FIGURES).join("grid_heat.png"), &grid_heat));
+
+    let encoded: Vec<Result<Vec<u8>, HarnessError>> = files
+        .par_iter()
+        .map(|(path, image)| {
+            image
+                .encode_png()
+                .map_err(|e| HarnessError::Report(format!("{}: PNG: {e}", dir.join(path).display())))
+        })
+        .collect();
+    for ((path, _), bytes) in files.iter().zip(encoded) {
+        let bytes = bytes?;
+        meshes::io::atomic_write(dir.join(path), |w| w.write_all(&bytes).map_err(meshes::MeshError::from))?;
+    }
+    Ok(files.into_iter().map(|(path, _)| path).collect())
+}
+
+/// One grid row: a scenario and its case per column (`None`: not run).
+struct Row<'a> {
+    scenario: &'a LoadedScenario,
+    cases: Vec<Option<&'a CaseResult>>,
+}
+
+/// The images of a row: its rest shape and one cell per column.
+struct RenderedRow {
+    rest: RgbImage,
+    cells: Vec<Cell>,
+}
+
+enum Cell {
+    NotRun,
+    Failed,
+    Rendered { shaded: RgbImage, heat: RgbImage },
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Shaded,
+    Heat,
+}
+
+/// The `#V x 3` result of a case, if it succeeded and fits its rest mesh.
+fn usable_positions<'a>(case: &'a CaseResult, scenario: &LoadedScenario) -> Option<&'a [[f64; 3]]> {
+    let positions = case.positions.as_deref()?;
+    (case.status == "ok" && positions.len() == scenario.mesh.n_vertices()).then_some(positions)
+}
+
+/// Every method with a result, in registry order, then unknown names in order of appearance.
+fn method_columns(results: &[CaseResult]) -> Vec<String> {
+    let mut columns: Vec<String> = methods::registry::method_names()
+        .into_iter()
+        .filter(|m| results.iter().any(|r| r.method == *m))
+        .map(String::from)
+        .collect();
+    for r in results {
+        if !columns.contains(&r.method) {
+            columns.push(r.method.clone());
+        }
+    }
+    columns
+}
+
+/// `#V` roles from the scenario's last handle set (which holds every region of the earlier steps).
+fn vertex_roles(scenario: &LoadedScenario) -> Vec<VertexRole> {
+    let mut roles = vec![VertexRole::Free; scenario.mesh.n_vertices()];
+    for region in scenario.steps.last().map(|s| s.handles.regions()).unwrap_or_default() {
+        let role = if region.name == "fixed" { VertexRole::Fixed } else { VertexRole::Handle };
+        for &v in &region.vertices {
+            if let Some(slot) = roles.get_mut(v as usize) {
+                *slot = role;
+            }
+        }
+    }
+    roles
+}
+
+fn render_row(row: &Row) -> RenderedRow {
+    let mesh = &row.scenario.mesh;
+    let (rest, triangles) = (mesh.positions(), mesh.triangles());
+    let results = row.cases.iter().flatten().filter_map(|c| usable_positions(c, row.scenario));
+    let camera = Camera::for_shapes(std::iter::once(rest).chain(results), 1.0);
+    let roles = vertex_roles(row.scenario);
+    let draw = |positions: &[[f64; 3]], paints: &[Paint]| {
+        render(&camera, positions, triangles, CELL_SIZE, CELL_SIZE, paints)
+    };
+    let rest_image = draw(rest, &[Paint::Roles(&roles)])
+        .pop()
+        .unwrap_or_else(|| RgbImage::filled(CELL_SIZE, CELL_SIZE, [255; 3]));
+    let cells = row
+        .cases
+        .par_iter()
+        .map(|case| {
+            let Some(case) = case else { return Cell::NotRun };
+            let Some(positions) = usable_positions(case, row.scenario) else { return Cell::Failed };
+            let errors = vertex_angle_errors(rest, positions, triangles);
+            let mut images = draw(positions, &[Paint::Roles(&roles), Paint::Heat(&errors)]).into_iter();
+            match (images.next(), images.next()) {
+                (Some(shaded), Some(heat)) => Cell::Rendered { shaded, heat },
+                _ => Cell::Failed,
+            }
+        })
+        .collect();
+    RenderedRow { rest: rest_image, cells }
+}
+
+/// The grid of `kind`: a header of column names, one row per scenario (label, `rest` render, one
+/// cell per column with its `E_theta / E_phi` caption), and a legend.
+fn grid_image(
+    rows: &[Row],
+    rendered: &[RenderedRow],
+    columns: &[String],
+    kind: Kind,
+) -> Result<RgbImage, String> {
+    let label_w = rows
+        .iter()
+        .map(|r| Label::new(&r.scenario.spec.name, NAME_PX, INK, (0.0, 0.0), Align::Left).width())
+        .chain([Label::new("procedural look-alike", DETAIL_PX, INK, (0.0, 0.0), Align::Left).width()])
+        .try_fold(120.0f64, |w, l| l.map(|l| w.max(l)))?
+        .ceil() as u32
+        + 24;
+    let row_h = CELL_SIZE + CAPTION_H + ROW_GAP;
+    let n_cols = columns.len() as u32 + 1;
+    let width = 2 * PAD + label_w + n_cols * CELL_SIZE;
+    let mut notes = vec![
+        format!(
+            "Orthographic view from ({}, {}, {}), z up; one camera per row, framing the rest shape and all \
+             results of the row. Headlight Lambert shading.",
+            VIEW_FROM[0], VIEW_FROM[1], VIEW_FROM[2]
+        ),
+        "E\u{3b8} / E\u{3c6}: RMS change of the corner / dihedral angles over the whole mesh (degrees)."
+            .to_string(),
+    ];
+    if kind == Kind::Heat {
+        notes.push("Rest column: fixed vertices blue, handle vertices orange.".to_string());
+    }
+    let notes = notes
+        .iter()
+        .map(|n| wrap(n, DETAIL_PX, (width - 2 * PAD) as f64))
+        .collect::<Result<Vec<_>, _>>()?
+        .concat();
+    let legend_h = LEGEND_H[(kind == Kind::Heat) as usize];
+    let footer_h = legend_h + notes.len() as u32 * NOTE_LINE_H;
+    let height = 2 * PAD + HEADER_H + rows.len().max(1) as u32 * row_h + footer_h;
+    let mut image = RgbImage::filled(width, height, [255; 3]);
+    let mut labels = Vec::new();
+    let cell_x = |c: u32| (PAD + label_w + c * CELL_SIZE) as i64;
+    let cell_y = |r: u32| (PAD + HEADER_H + r * row_h) as i64;
+
+    for (c, name) in std::iter::once("rest").chain(columns.iter().map(String::as_str)).enumerate() {
+        let x = cell_x(c as u32) as f64 + CELL_SIZE as f64 / 2.0;
+        let mut label = Label::new(name, NAME_PX, INK, (x, (PAD + HEADER_H - 16) as f64), Align::Center);
+        // A long method name is set smaller rather than run into its neighbours.
+        let room = (CELL_SIZE - 16) as f64;
+        label.size *= (room / label.width()?).min(1.0);
+        labels.push(label);
+    }
+    image.fill_rect(PAD as i64, (PAD + HEADER_H - 4) as i64, width - 2 * PAD, 1, RULE);
+    if rows.is_empty() {
+        labels.push(Label::new(
+            "no results",
+            CAPTION_PX,
+            MUTED,
+            (cell_x(0) as f64 + 8.0, cell_y(0) as f64 + 40.0),
+            Align::Left,
+        ));
+    }
+
+    for (r, (row, images)) in rows.iter().zip(rendered).enumerate() {
+        let (top, mid) = (cell_y(r as u32), cell_y(r as u32) + CELL_SIZE as i64 / 2);
+        let scenario = row.scenario;
+        labels.push(Label::new(
+            &scenario.spec.name,
+            NAME_PX,
+            INK,
+            (PAD as f64, mid as f64 - 6.0),
+            Align::Left,
+        ));
+        let size = format!("{} vertices", scenario.mesh.n_vertices());
+        labels.push(Label::new(size, DETAIL_PX, MUTED, (PAD as f64, mid as f64 + 20.0), Align::Left));
+        labels.push(Label::new(
+            &scenario.mesh_source,
+            DETAIL_PX,
+            MUTED,
+            (PAD as f64, mid as f64 + 42.0),
+            Align::Left,
+        ));
+        image.paste(&images.rest, cell_x(0), top);
+        for (c, (case, cell)) in row.cases.iter().zip(&images.cells).enumerate() {
+            let (x, centre) = (cell_x(c as u32 + 1), cell_x(c as u32 + 1) as f64 + CELL_SIZE as f64 / 2.0);
+            let inset = |image: &mut RgbImage, color| {
+                image.fill_rect(x + 6, top + 6, CELL_SIZE - 12, CELL_SIZE - 12, color)
+            };
+            match cell {
+                Cell::NotRun => {
+                    inset(&mut image, EMPTY_CELL);
+                    labels.push(Label::new(
+                        "not run",
+                        CAPTION_PX,
+                        FAINT,
+                        (centre, mid as f64 + 6.0),
+                        Align::Center,
+                    ));
+                }
+                Cell::Failed => {
+                    inset(&mut image, FAILED_CELL);
+                    labels.push(Label::new(
+                        "failed",
+                        NAME_PX,
+                        FAILED_INK,
+                        (centre, mid as f64 + 7.0),
+                        Align::Center,
+                    ));
+                }
+                Cell::Rendered { shaded, heat } => {
+                    image.paste(if kind == Kind::Shaded { shaded } else { heat }, x, top);
+                    if let Some(case) = case {
+                        let caption = (centre, (top + CELL_SIZE as i64 + 27) as f64);
+                        labels.push(error_caption(case.e_theta_deg, case.e_phi_deg, caption));
+                    }
+                }
+            }
+        }
+        if r + 1 < rows.len() {
+            let y = top + (CELL_SIZE + CAPTION_H + ROW_GAP / 2) as i64;
+            image.fill_rect(PAD as i64, y, width - 2 * PAD, 1, RULE);
+        }
+    }
+
+    let footer = (PAD + HEADER_H + rows.len().max(1) as u32 * row_h) as i64 + 8;
+    match kind {
+        Kind::Shaded => role_legend(&mut image, &mut labels, PAD as i64, footer),
+        Kind::Heat => heat_legend(&mut image, &mut labels, PAD as i64, footer),
+    }
+    for (i, line) in notes.into_iter().enumerate() {
+        let y = footer + (legend_h + (i as u32 + 1) * NOTE_LINE_H) as i64 - 8;
+        labels.push(Label::new(line, DETAIL_PX, MUTED, (PAD as f64, y as f64), Align::Left));
+    }
+    draw_labels(&mut image, &labels)?;
+    Ok(image)
+}
+
+/// "E_θ x.xx° / E_φ y.yy°" centred at `(x, baseline)`.
+fn error_caption(e_theta: f64, e_phi: f64, at: (f64, f64)) -> Label {
+    let value = |v: f64| if v.is_finite() { format!(" {v:.2}\u{b0}") } else { " n/a".to_string() };
+    let (theta, phi) = (value(e_theta), value(e_phi));
+    let spans = [
+        ("E", false),
+        ("\u{3b8}", true),
+        (&theta, false),
+        ("  /  E", false),
+        ("\u{3c6}", true),
+        (&phi, false),
+    ];
+    Label::rich(&spans, CAPTION_PX, INK, at, Align::Center)
+}
+
+/// Swatches of the vertex roles, at `(x, y)` (top-left).
+fn role_legend(image: &mut RgbImage, labels: &mut Vec<Label>, x: i64, y: i64) {
+    let mut left = x;
+    for (role, name) in
+        [(VertexRole::Fixed, "fixed"), (VertexRole::Handle, "handle"), (VertexRole::Free, "free")]
+    {
+        image.fill_rect(left, y + 8, 20, 20, role.color().map(|c| (255.0 * c).round() as u8));
+        labels.push(Label::new(name, LEGEND_PX, INK, ((left + 28) as f64, (y + 25) as f64), Align::Left));
+        left += 120;
+    }
+}
+
+/// The heat colour bar `0..HEAT_MAX_DEG` under its title, with ticks, at `(x, y)` (top-left).
+fn heat_legend(image: &mut RgbImage, labels: &mut Vec<Label>, x: i64, y: i64) {
+    const BAR_W: u32 = 360;
+    const BAR_H: u32 = 16;
+    let title = "Per-vertex RMS change of the corner angles (degrees), one scale for all cells";
+    labels.push(Label::new(title, LEGEND_PX, INK, (x as f64, (y + 22) as f64), Align::Left));
+    let bar_y = y + 32;
+    for i in 0..BAR_W {
+        let degrees = HEAT_MAX_DEG * (i as f64 + 0.5) / BAR_W as f64;
+        let color = heat_color(degrees).map(|c| (255.0 * c).round() as u8);
+        image.fill_rect(x + i as i64, bar_y, 1, BAR_H, color);
+    }
+    let ticks = 5;
+    for t in 0..=ticks {
+        let tx = x + (t * (BAR_W - 1) / ticks) as i64;
+        image.fill_rect(tx, bar_y + BAR_H as i64, 1, 5, INK);
+        let degrees = HEAT_MAX_DEG * t as f64 / ticks as f64;
+        // The top colour stands for everything above the scale.
+        let text = if t == ticks { format!("\u{2265}{degrees}\u{b0}") } else { format!("{degrees}\u{b0}") };
+        let at = (tx as f64, (bar_y + BAR_H as i64 + 22) as f64);
+        labels.push(Label::new(text, TICK_PX, INK, at, Align::Center));
+    }
+}
+
+/// `text` broken at spaces into lines at most `max_width` pixels wide at font size `size` (a word
+/// longer than that gets a line of its own).
+fn wrap(text: &str, size: f64, max_width: f64) -> Result<Vec<String>, String> {
+    let mut lines: Vec<String> = Vec::new();
+    for word in text.split(' ').filter(|w| !w.is_empty()) {
+        match lines.last_mut() {
+            Some(line)
+                if Label::new(format!("{line} {word}"), size, INK, (0.0, 0.0), Align::Left).width()?
+                    <= max_width =>
+            {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    Ok(lines)
+}
+
+/// `name` with every character other than ASCII letters, digits, `-`, `_` and `.` replaced by `_`,
+/// so it is one file name on every system.
+fn file_name(name: &str) -> String {
+    let cleaned: String =
+        name.chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '_' }).collect();
+    if cleaned.is_empty() || cleaned.chars().all(|c| c == '.') {
+        format!("_{cleaned}")
+    } else {
+        cleaned
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::{LoadedStep, Motion, ScenarioSpec};
+    use meshes::shapes::{generate, ShapeKind};
+    use meshes::{AffineTransform, Topology, VertexStatus};
+    use methods::{HandleRegion, HandleSet};
+
+    /// A procedural cylinder with the survey's fixed and handle regions.
+    fn scenario(name: &str) -> LoadedScenario {
+        let shape = generate(ShapeKind::Cylinder, 800).unwrap();
+        let of = |status: VertexStatus| {
+            shape.selection.iter().enumerate().filter(|(_, s)| **s == status).map(|(v, _)| v as u32).collect()
+        };
+        let regions = vec![
+            HandleRegion { name: "fixed".into(), vertices: of(VertexStatus::Fixed) },
+            HandleRegion { name: "handle".into(), vertices: of(VertexStatus::Handle) },
+        ];
+        let handles = HandleSet::new(regions, shape.mesh.n_vertices()).unwrap();
+        let spec = ScenarioSpec {
+            name: name.into(),
+            description: String::new(),
+            survey: None,
+            procedural: None,
+            methods: None,
+            steps: Vec::new(),
+            path: PathBuf::new(),
+        };
+        LoadedScenario {
+            spec,
+            mesh_source: "procedural look-alike".into(),
+            topology: Topology::new(&shape.mesh).unwrap(),
+            mesh: shape.mesh,
+            steps: vec![LoadedStep {
+                handles,
+                motions: vec![Motion::Hold, Motion::Transform(shape.transform)],
+            }],
+        }
+    }
+
+    fn case(scenario: &str, method: &str, status: &str, positions: Option<Vec<[f64; 3]>>) -> CaseResult {
+        CaseResult {
+            scenario: scenario.into(),
+            method: method.into(),
+            mesh_source: "procedural look-alike".into(),
+            vertices: 0,
+            faces: 0,
+            precompute_s: 0.0,
+            bind_s: 0.0,
+            median_iteration_ms: 0.0,
+            iterations: 1,
+            solve_s: 0.0,
+            total_s: 0.0,
+            converged: true,
+            e_theta_deg: 1.234,
+            e_phi_deg: f64::NAN,
+            handle_residual_over_diag: 0.0,
+            rms_to_arap_over_diag: None,
+            status: status.into(),
+            phase_timings: Vec::new(),
+            statistics: Vec::new(),
+            steps: Vec::new(),
+            trace: Vec::new(),
+            positions,
+        }
+    }
+
+    /// Scenario `tiny`: `laplacian` bent, `odd/name` with a NaN vertex, `arap` failed; scenario
+    /// `other`: `arap` only, its shape too short (a broken result); scenario `unused`: no results.
+    fn inputs() -> (Vec<CaseResult>, Vec<LoadedScenario>) {
+        let scenarios = vec![scenario("tiny"), scenario("other"), scenario("unused")];
+        let rest = scenarios[0].mesh.positions();
+        let bend = AffineTransform::rotation_about([0.0, 1.0, 0.0], 0.6, [0.0, 0.0, 0.0]);
+        let bent: Vec<[f64; 3]> = rest.iter().map(|&p| if p[2] > 6.0 { bend.apply(p) } else { p }).collect();
+        let mut with_nan = rest.to_vec();
+        with_nan[3] = [f64::NAN; 3];
+        let results = vec![
+            case("tiny", "laplacian", "ok", Some(bent)),
+            case("tiny", "arap", "failed: diverged", None),
+            case("tiny", "odd/name", "ok", Some(with_nan)),
+            case("other", "arap", "ok", Some(rest[..10].to_vec())),
+        ];
+        (results, scenarios)
+    }
+
+    fn decode(path: &Path) -> image::RgbImage {
+        image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgb8()
+    }
+
+    #[test]
+    fn write_figures_writes_every_expected_file_deterministically() {
+        let (results, scenarios) = inputs();
+        let dirs = [tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap()];
+        let written = write_figures(dirs[0].path(), &results, &scenarios).unwrap();
+        let expected = [
+            "tiny-rest.png",
+            "tiny-laplacian.png",
+            "tiny-laplacian-heat.png",
+            "tiny-odd_name.png",
+            "tiny-odd_name-heat.png",
+            "other-rest.png",
+            "grid.png",
+            "grid_heat.png",
+        ];
+        let expected: Vec<PathBuf> = expected.iter().map(|f| Path::new("figures").join(f)).collect();
+        assert_eq!(written, expected);
+        let mut on_disk: Vec<String> = std::fs::read_dir(dirs[0].path().join("figures"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        on_disk.sort();
+        let mut names: Vec<String> =
+            expected.iter().map(|p| p.file_name().unwrap().to_string_lossy().into()).collect();
+        names.sort();
+        assert_eq!(on_disk, names, "nothing else, no temporary files left");
+        for path in &written {
+            let image = decode(&dirs[0].path().join(path));
+            if !path.ends_with("grid.png") && !path.ends_with("grid_heat.png") {
+                assert_eq!(image.dimensions(), (CELL_SIZE, CELL_SIZE), "{}", path.display());
+            }
+        }
+        // Columns: rest + laplacian, arap (registry order) + odd/name; rows: tiny, other.
+        let grid = decode(&dirs[0].path().join("figures/grid.png"));
+        assert!(grid.width() > 4 * CELL_SIZE && grid.width() < 5 * CELL_SIZE, "{}", grid.width());
+        assert!(grid.height() > 2 * CELL_SIZE && grid.height() < 3 * CELL_SIZE, "{}", grid.height());
+        let heat = decode(&dirs[0].path().join("figures/grid_heat.png"));
+        assert_eq!(heat.width(), grid.width());
+        assert!(heat.height() > grid.height(), "the colour bar takes more room than the swatches");
+
+        assert_eq!(write_figures(dirs[1].path(), &results, &scenarios).unwrap(), written);
+        for path in &written {
+            let bytes = |d: &tempfile::TempDir| std::fs::read(d.path().join(path)).unwrap();
+            assert!(bytes(&dirs[0]) == bytes(&dirs[1]), "{} differs between runs", path.display());
+        }
+    }
+
+    #[test]
+    fn renders_show_the_regions_and_the_heat_map_the_bend() {
+        let (results, scenarios) = inputs();
+        let dir = tempfile::tempdir().unwrap();
+        write_figures(dir.path(), &results, &scenarios).unwrap();
+        let count = |image: &image::RgbImage, role: VertexRole| {
+            let [r, g, b] = role.color();
+            // Same hue under any shading: compare colour ratios.
+            image
+                .pixels()
+                .filter(|p| {
+                    let [pr, pg, pb] = p.0.map(|c| c as f64 + 1.0);
+                    (pr / pb - (r + 0.004) / (b + 0.004)).abs() < 0.15 * (r / b).max(1.0)
+                        && (pg / pb - (g + 0.004) / (b + 0.004)).abs() < 0.15 * (g / b).max(1.0)
+                        && p.0 != [255; 3]
+                })
+                .count()
+        };
+        let rest = decode(&dir.path().join("figures/tiny-rest.png"));
+        assert!(count(&rest, VertexRole::Fixed) > 100, "fixed region visible");
+        assert!(count(&rest, VertexRole::Handle) > 100, "handle region visible");
+        let background = rest.pixels().filter(|p| p.0 == [255; 3]).count();
+        assert!(background > 1000 && background < (CELL_SIZE * CELL_SIZE) as usize * 9 / 10);
+        // The bend changes corner angles only where the cylinder is cut at z = 6: hot pixels exist,
+        // and most of the surface stays at the cold end of the scale.
+        let heat = decode(&dir.path().join("figures/tiny-laplacian-heat.png"));
+        let red = heat.pixels().filter(|p| p.0[0] > 150 && p.0[2] < 90).count();
+        let blue = heat.pixels().filter(|p| p.0[2] > p.0[0] + 40).count();
+        assert!(red > 10 && blue > 10 * red, "red {red}, blue {blue}");
+        let undeformed = decode(&dir.path().join("figures/tiny-odd_name-heat.png"));
+        assert_eq!(undeformed.pixels().filter(|p| p.0[0] > 150 && p.0[2] < 90).count(), 0);
+    }
+
+    #[test]
+    fn no_results_still_give_both_grids() {
+        let dir = tempfile::tempdir().unwrap();
+        let written = write_figures(dir.path(), &[], &[scenario("unused")]).unwrap();
+        assert_eq!(written, [Path::new("figures/grid.png"), Path::new("figures/grid_heat.png")]);
+        assert!(written.iter().all(|p| dir.path().join(p).is_file()));
+    }
+
+    #[test]
+    fn notes_wrap_at_spaces_within_the_width() {
+        crate::fonts::register_sans_serif().unwrap();
+        let text = "one two three four five six seven eight nine ten";
+        let lines = wrap(text, DETAIL_PX, 120.0).unwrap();
+        assert!(lines.len() > 2, "{lines:?}");
+        assert_eq!(lines.join(" "), text);
+        for line in &lines {
+            assert!(
+                Label::new(line.as_str(), DETAIL_PX, INK, (0.0, 0.0), Align::Left).width().unwrap() <= 120.0
+            );
+        }
+        assert_eq!(wrap(text, DETAIL_PX, 1e6).unwrap(), [text]);
+        assert_eq!(wrap("", DETAIL_PX, 10.0).unwrap(), Vec::<String>::new());
+    }
+
+    #[test]
+    fn file_names_keep_safe_characters_only() {
+        assert_eq!(file_name("bar-sweep_6k.v2"), "bar-sweep_6k.v2");
+        assert_eq!(file_name("a/b c\\d"), "a_b_c_d");
+        assert_eq!(file_name(".."), "_..");
+        assert_eq!(file_name(""), "_");
+    }
+}
