@@ -4,19 +4,21 @@ use std::ops::ControlFlow;
 use std::time::Instant;
 
 use methods::{IterationObserver, IterationReport};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::metrics::{angle_errors, handle_residual, RestAngles};
 use crate::scenario::LoadedScenario;
 
 /// One iteration as recorded for convergence curves.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
 pub struct IterationRecord {
     /// 1-based edit step of the scenario.
     pub edit_step: usize,
     /// 0-based within the edit step.
     pub iteration: usize,
+    #[serde(deserialize_with = "nan_from_null")]
     pub step: f64,
+    #[serde(deserialize_with = "nan_from_null")]
     pub seconds: f64,
     /// `E_theta` / `E_phi` (degrees) of the iterate, on the iterations [`records_quality`] selects.
     pub e_theta_deg: Option<f64>,
@@ -31,7 +33,7 @@ pub fn records_quality(i: usize) -> bool {
 }
 
 /// One edit step of a case: a handle set bound and solved for.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StepRecord {
     /// 1-based.
     pub step: usize,
@@ -39,10 +41,13 @@ pub struct StepRecord {
     pub handles: usize,
     pub constrained_vertices: usize,
     /// Wall time of `bind_handles`: the handle-set update a user waits for.
+    #[serde(deserialize_with = "nan_from_null")]
     pub bind_s: f64,
+    #[serde(deserialize_with = "nan_from_null")]
     pub solve_s: f64,
     pub iterations: usize,
     pub converged: bool,
+    #[serde(deserialize_with = "nan_from_null")]
     pub median_iteration_ms: f64,
     /// The method's phase timings after this step (e.g. HIRM's `t_h_handle_update`).
     pub phase_timings: Vec<(String, f64)>,
@@ -50,22 +55,30 @@ pub struct StepRecord {
 
 /// Measurements of one case. Times are wall-clock seconds; the `*_over_diag` values are relative to
 /// the rest bounding-box diagonal; angle errors are in degrees.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CaseResult {
     pub scenario: String,
     pub method: String,
     pub mesh_source: String,
     pub vertices: usize,
     pub faces: usize,
+    #[serde(deserialize_with = "nan_from_null")]
     pub precompute_s: f64,
+    #[serde(deserialize_with = "nan_from_null")]
     pub bind_s: f64,
+    #[serde(deserialize_with = "nan_from_null")]
     pub median_iteration_ms: f64,
     pub iterations: usize,
+    #[serde(deserialize_with = "nan_from_null")]
     pub solve_s: f64,
+    #[serde(deserialize_with = "nan_from_null")]
     pub total_s: f64,
     pub converged: bool,
+    #[serde(deserialize_with = "nan_from_null")]
     pub e_theta_deg: f64,
+    #[serde(deserialize_with = "nan_from_null")]
     pub e_phi_deg: f64,
+    #[serde(deserialize_with = "nan_from_null")]
     pub handle_residual_over_diag: f64,
     /// Filled in once the scenario's `arap` result is known.
     pub rms_to_arap_over_diag: Option<f64>,
@@ -214,6 +227,11 @@ pub fn run_case(
         Err(e) => format!("failed: {e}"),
     };
     result
+}
+
+/// `results.json` writes a missing (NaN) number as `null`; read it back as NaN.
+fn nan_from_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 /// Median iteration time in milliseconds (NaN for none).

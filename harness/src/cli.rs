@@ -1,11 +1,13 @@
-//! The command line of the harness (`all`, `run`, `list`): the CLI edge, where errors become `anyhow`
-//! messages and exit codes. In the library so the end-to-end tests drive exactly what the binary runs.
+//! The command line of the harness (`all`, `run`, `check`, `baseline`, `list`): the CLI edge, where
+//! errors become `anyhow` messages and exit codes. In the library so the end-to-end tests drive
+//! exactly what the binary runs.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use crate::scenario::load_specs;
 use crate::suite::{self, SuiteOptions, SURVEY_DIR_ENV};
+use crate::{html, plots, regression, render, report};
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
 
@@ -22,8 +24,16 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run every method on every scenario and write reports/.
-    All(Common),
+    /// Run every method on every scenario, write reports/ and end with the regression check.
+    All {
+        #[command(flatten)]
+        common: Common,
+        #[command(flatten)]
+        gate: Gate,
+        /// Skip the regression check.
+        #[arg(long)]
+        no_check: bool,
+    },
     /// Run chosen methods on one scenario and print the results (writes reports/ like `all`).
     Run {
         /// Method name (repeatable; see `list`).
@@ -35,8 +45,36 @@ enum Command {
         #[command(flatten)]
         common: Common,
     },
+    /// Compare reports/results.json with the baseline; exit non-zero naming every regression.
+    Check {
+        #[command(flatten)]
+        common: Common,
+        #[command(flatten)]
+        gate: Gate,
+    },
+    /// Rewrite the baseline from reports/results.json (on purpose: after a change that is meant to
+    /// alter results).
+    Baseline {
+        #[command(flatten)]
+        common: Common,
+        #[command(flatten)]
+        gate: Gate,
+    },
     /// List the registered methods and the scenarios.
     List(Common),
+}
+
+#[derive(Args, Clone)]
+struct Gate {
+    /// The regression baseline [default: reports/baseline.json in the workspace].
+    #[arg(long)]
+    baseline: Option<PathBuf>,
+}
+
+impl Gate {
+    fn path(&self) -> PathBuf {
+        self.baseline.clone().unwrap_or_else(|| suite::workspace_root().join("reports/baseline.json"))
+    }
 }
 
 #[derive(Args, Clone)]
@@ -74,6 +112,8 @@ impl Common {
 pub const EXIT_CASE_FAILED: u8 = 1;
 /// Exit code of bad input or I/O errors (nothing written).
 pub const EXIT_ERROR: u8 = 2;
+/// Exit code of a run or check that found quality regressions against the baseline.
+pub const EXIT_REGRESSION: u8 = 3;
 
 /// Parse `args` (program name first) and run. `Err` means bad input or I/O failure: the caller prints
 /// it and exits with [`EXIT_ERROR`]; argument errors exit inside clap as usual.
@@ -84,8 +124,53 @@ where
 {
     let cli = Cli::parse_from(args);
     match cli.command {
-        Command::All(common) => execute(&common.options(Vec::new(), Vec::new())),
-        Command::Run { methods, scenario, common } => execute(&common.options(vec![scenario], methods)),
+        Command::All { common, gate, no_check } => {
+            let options = common.options(Vec::new(), Vec::new());
+            let default_configs = suite::workspace_root().join("configs");
+            let same = |a: &std::path::Path, b: &std::path::Path| {
+                a.canonicalize().ok().zip(b.canonicalize().ok()).is_some_and(|(a, b)| a == b)
+            };
+            let gate = if no_check {
+                Err("--no-check".to_string())
+            } else if !same(&options.configs_dir, &default_configs) {
+                Err(format!("the baseline covers the scenarios of {}", default_configs.display()))
+            } else {
+                Ok(gate.path())
+            };
+            execute(&options, gate)
+        }
+        Command::Run { methods, scenario, common } => {
+            execute(&common.options(vec![scenario], methods), Err("`run` covers one scenario".to_string()))
+        }
+        Command::Check { common, gate } => {
+            let dir = common.options(Vec::new(), Vec::new()).reports_dir;
+            let (results, _) = regression::read_results(&dir.join("results.json"))?;
+            let baseline = regression::read_baseline(&gate.path())?;
+            let foreign = regression::foreign_cases(&baseline, &results);
+            if !foreign.is_empty() {
+                anyhow::bail!(
+                    "{}: the baseline is for {} data; these cases ran on other data: {}",
+                    gate.path().display(),
+                    baseline.mesh_source,
+                    foreign.join(", ")
+                );
+            }
+            let findings = regression::check(&baseline, &results);
+            Ok(print_findings(&findings, &gate.path()))
+        }
+        Command::Baseline { common, gate } => {
+            let dir = common.options(Vec::new(), Vec::new()).reports_dir;
+            let (results, _) = regression::read_results(&dir.join("results.json"))?;
+            let baseline = regression::baseline_from(&results);
+            regression::write_baseline(&gate.path(), &baseline)?;
+            println!(
+                "baseline: {} cases from {} written to {}",
+                baseline.cases.len(),
+                dir.display(),
+                gate.path().display()
+            );
+            Ok(ExitCode::SUCCESS)
+        }
         Command::List(common) => {
             let options = common.options(Vec::new(), Vec::new());
             println!("methods:");
@@ -101,10 +186,57 @@ where
     }
 }
 
-fn execute(options: &SuiteOptions) -> anyhow::Result<ExitCode> {
+/// Print the gate's findings; the exit code is [`EXIT_REGRESSION`] if any is a regression.
+fn print_findings(findings: &[regression::Finding], baseline: &std::path::Path) -> ExitCode {
+    let regressions = findings.iter().filter(|f| f.is_regression()).count();
+    for f in findings {
+        if f.is_regression() {
+            eprintln!("regression: {f}");
+        } else {
+            println!("{f}");
+        }
+    }
+    if regressions > 0 {
+        eprintln!("error: {regressions} quality regression(s) against {}", baseline.display());
+        ExitCode::from(EXIT_REGRESSION)
+    } else {
+        println!("check: no quality regression against {}", baseline.display());
+        ExitCode::SUCCESS
+    }
+}
+
+/// Run the suite, write every report, and compare with the baseline at `gate` (or say why not).
+fn execute(options: &SuiteOptions, gate: Result<PathBuf, String>) -> anyhow::Result<ExitCode> {
     let run = suite::run(options).context("preparing the run")?;
-    crate::report::write_reports(&options.reports_dir, &run.results, &run.scenarios, &run.data_source)
-        .context("writing reports")?;
+    let dir = &options.reports_dir;
+    report::write_reports(dir, &run.results, &run.scenarios, &run.data_source).context("writing reports")?;
+    let mut images = plots::write_plots(dir, &run.results).context("writing plots")?;
+    images.extend(render::write_figures(dir, &run.results, &run.scenarios).context("writing figures")?);
+
+    let findings = match gate {
+        Ok(path) if path.is_file() => {
+            let baseline = regression::read_baseline(&path)?;
+            let foreign = regression::foreign_cases(&baseline, &run.results);
+            if foreign.is_empty() {
+                Ok((path, regression::check(&baseline, &run.results)))
+            } else {
+                Err(format!("the baseline is for {} data, this run is not", baseline.mesh_source))
+            }
+        }
+        Ok(path) => Err(format!("no baseline at {} (write one with `harness baseline`)", path.display())),
+        Err(reason) => Err(reason),
+    };
+    let verdict = match &findings {
+        Ok((_, f)) => html::Verdict::Checked {
+            findings: f.iter().map(|f| f.to_string()).collect(),
+            regressions: f.iter().filter(|f| f.is_regression()).count(),
+        },
+        Err(reason) => html::Verdict::NotChecked(reason.clone()),
+    };
+    let table1 = report::render_table1(&run.results);
+    html::write_index(dir, &html::render_index(&run.results, &run.data_source, &images, &table1, &verdict))
+        .context("writing index.html")?;
+
     println!("data: {}", run.data_source);
     println!(
         "{:<12} {:<12} {:>7} {:>10} {:>9} {:>10} {:>6} {:>9} {:>9} {:>10} {:>10}  status",
@@ -141,10 +273,17 @@ fn execute(options: &SuiteOptions) -> anyhow::Result<ExitCode> {
             failed += 1;
         }
     }
-    println!("reports: {}", options.reports_dir.display());
+    println!("reports: {} (open index.html)", options.reports_dir.display());
+    let gate_code = match &findings {
+        Ok((path, f)) => print_findings(f, path),
+        Err(reason) => {
+            println!("regression check skipped: {reason}");
+            ExitCode::SUCCESS
+        }
+    };
     if failed > 0 {
         eprintln!("error: {failed} case(s) failed (see the status column)");
         return Ok(ExitCode::from(EXIT_CASE_FAILED));
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(gate_code)
 }

@@ -1,0 +1,251 @@
+//! `reports/index.html`: the results table, the regression verdict, HIRM's Table 1, the rendered
+//! figures and every plot on one page that opens from disk (relative links only, no server, no
+//! external resources). A script at the end counts the images that loaded and writes the count into
+//! `#image-check` (`data-loaded` / `data-total` attributes), which the browser test reads.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::case::CaseResult;
+use crate::error::HarnessError;
+
+/// What the regression gate said about the run, for the page.
+pub enum Verdict {
+    /// Compared with the baseline: the findings as text, and whether any is a regression.
+    Checked { findings: Vec<String>, regressions: usize },
+    /// Not compared, and why.
+    NotChecked(String),
+}
+
+/// Escape text for HTML element content and attribute values.
+fn escape(text: &str) -> String {
+    text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+fn number(v: f64, digits: usize) -> String {
+    if v.is_finite() {
+        format!("{v:.digits$}")
+    } else {
+        "–".into()
+    }
+}
+
+/// The page for `results` (with `data_source`), linking `images` (paths relative to the report
+/// directory: plots and figures) and showing `table1_markdown` (HIRM's Table 1 as written to
+/// `table1.md`).
+pub fn render_index(
+    results: &[CaseResult],
+    data_source: &str,
+    images: &[PathBuf],
+    table1_markdown: &str,
+    verdict: &Verdict,
+) -> String {
+    let mut page = String::new();
+    page.push_str(concat!(
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n",
+        "<title>deformbench report</title>\n<style>\n",
+        "body{font-family:sans-serif;margin:2em;max-width:1500px;color:#222}\n",
+        "table{border-collapse:collapse;font-size:13px;margin:1em 0}\n",
+        "th,td{border:1px solid #ccc;padding:3px 7px;text-align:right}\n",
+        "th{background:#f0f0f0}td.text{text-align:left}\n",
+        "tr.failed td{background:#fdd}\n",
+        ".pass{color:#060}.fail{color:#a00}\n",
+        "img{max-width:100%;border:1px solid #ddd;margin:4px 0}\n",
+        "figure{margin:1em 0}figcaption{font-size:13px;color:#555}\n",
+        "</style>\n</head>\n<body>\n",
+        "<h1>deformbench: handle-based mesh deformation, side by side</h1>\n"
+    ));
+    let _ = writeln!(
+        page,
+        "<p>Data: {}. Angles in degrees (E_θ: RMS change of the triangle corner angles; E_φ: RMS change of the \
+         dihedral angles of interior edges). Times in seconds, iteration times in milliseconds; residual and \
+         RMS to <code>arap</code> relative to the rest bounding-box diagonal.</p>",
+        escape(data_source)
+    );
+
+    page.push_str("<h2 id=\"verdict\">Quality regression gate</h2>\n");
+    match verdict {
+        Verdict::Checked { findings, regressions } => {
+            if *regressions == 0 {
+                page.push_str(
+                    "<p class=\"pass\">No regression against <code>reports/baseline.json</code>.</p>\n",
+                );
+            } else {
+                let _ = writeln!(
+                    page,
+                    "<p class=\"fail\">{regressions} regression(s) against <code>reports/baseline.json</code>:</p>"
+                );
+            }
+            if !findings.is_empty() {
+                page.push_str("<ul>\n");
+                for f in findings {
+                    let _ = writeln!(page, "<li>{}</li>", escape(f));
+                }
+                page.push_str("</ul>\n");
+            }
+        }
+        Verdict::NotChecked(reason) => {
+            let _ = writeln!(page, "<p>Not checked: {}</p>", escape(reason));
+        }
+    }
+
+    page.push_str("<h2 id=\"results\">Results</h2>\n<table>\n<tr><th>scenario</th><th>method</th><th>#V</th>\
+                   <th>E_θ</th><th>E_φ</th><th>iterations</th><th>converged</th><th>precompute</th><th>bind</th>\
+                   <th>solve</th><th>total</th><th>iteration (ms)</th><th>residual</th><th>RMS to arap</th>\
+                   <th>status</th></tr>\n");
+    for r in results {
+        let class = if r.status == "ok" { "" } else { " class=\"failed\"" };
+        let _ = writeln!(
+            page,
+            "<tr{class}><td class=\"text\">{}</td><td class=\"text\">{}</td><td>{}</td><td>{}</td><td>{}</td>\
+             <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>\
+             <td class=\"text\">{}</td></tr>",
+            escape(&r.scenario),
+            escape(&r.method),
+            r.vertices,
+            number(r.e_theta_deg, 3),
+            number(r.e_phi_deg, 3),
+            r.iterations,
+            if r.converged { "yes" } else { "no" },
+            number(r.precompute_s, 3),
+            number(r.bind_s, 4),
+            number(r.solve_s, 3),
+            number(r.total_s, 3),
+            number(r.median_iteration_ms, 3),
+            if r.handle_residual_over_diag.is_finite() { format!("{:.1e}", r.handle_residual_over_diag) } else { "–".into() },
+            r.rms_to_arap_over_diag.map_or("–".into(), |v| format!("{v:.1e}")),
+            escape(&r.status),
+        );
+    }
+    page.push_str("</table>\n");
+
+    let (figures, plots): (Vec<&PathBuf>, Vec<&PathBuf>) = images
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        .partition(|p| p.starts_with("figures"));
+    let grids: Vec<&&PathBuf> = figures
+        .iter()
+        .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("grid")))
+        .collect();
+    if !grids.is_empty() {
+        page.push_str("<h2 id=\"figures\">Rendered results</h2>\n");
+        for g in grids {
+            image(&mut page, g, caption_for(g));
+        }
+    }
+    if !plots.is_empty() {
+        page.push_str("<h2 id=\"plots\">Plots</h2>\n");
+        for p in &plots {
+            image(&mut page, p, caption_for(p));
+        }
+    }
+    if table1_markdown.lines().filter(|l| l.starts_with('|')).count() > 2 {
+        page.push_str("<h2 id=\"table1\">Handle-set update (HIRM Table 1)</h2>\n");
+        page.push_str(&markdown_table(table1_markdown));
+    }
+    let single: Vec<&&PathBuf> = figures
+        .iter()
+        .filter(|p| !p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("grid")))
+        .collect();
+    if !single.is_empty() {
+        let _ = writeln!(
+            page,
+            "<h2 id=\"renders\">Every render</h2>\n<details><summary>{} images: rest shapes, results and \
+             angle-error heat maps (0–10°) of every case</summary>",
+            single.len()
+        );
+        for p in single {
+            let _ = writeln!(
+                page,
+                "<img src=\"{u}\" alt=\"{u}\" title=\"{u}\" loading=\"eager\" style=\"max-width:240px\">",
+                u = escape(&link(p)),
+            );
+        }
+        page.push_str("</details>\n");
+    }
+    page.push_str(concat!(
+        "<p id=\"image-check\" data-loaded=\"\" data-total=\"\"></p>\n",
+        "<script>\n",
+        "window.addEventListener('load', function () {\n",
+        "  var images = Array.prototype.slice.call(document.images);\n",
+        "  var loaded = images.filter(function (i) { return i.complete && i.naturalWidth > 0; });\n",
+        "  var broken = images.filter(function (i) { return !(i.complete && i.naturalWidth > 0); })\n",
+        "    .map(function (i) { return i.getAttribute('src'); });\n",
+        "  var p = document.getElementById('image-check');\n",
+        "  p.dataset.loaded = loaded.length; p.dataset.total = images.length;\n",
+        "  p.dataset.broken = broken.join(' ');\n",
+        "  p.textContent = 'Images loaded: ' + loaded.length + ' of ' + images.length + '.';\n",
+        "});\n",
+        "</script>\n</body>\n</html>\n"
+    ));
+    page
+}
+
+/// A path relative to the report directory as a URL path (forward slashes).
+fn link(path: &Path) -> String {
+    path.components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect::<Vec<_>>().join("/")
+}
+
+fn caption_for(path: &Path) -> String {
+    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+}
+
+fn image(page: &mut String, path: &Path, caption: String) {
+    let url = link(path);
+    let svg = path.with_extension("svg");
+    let _ = writeln!(
+        page,
+        "<figure><a href=\"{u}\"><img src=\"{u}\" alt=\"{c}\" loading=\"eager\"></a><figcaption>{c} \
+         (<a href=\"{s}\">SVG</a>)</figcaption></figure>",
+        u = escape(&url),
+        c = escape(&caption),
+        s = escape(&link(&svg)),
+    );
+}
+
+/// The pipe tables of `markdown` as HTML tables; other lines as paragraphs.
+fn markdown_table(markdown: &str) -> String {
+    let mut out = String::new();
+    let mut in_table = false;
+    let mut header = true;
+    for line in markdown.lines() {
+        let line = line.trim();
+        if line.starts_with('|') {
+            let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
+            if cells.iter().all(|c| c.chars().all(|ch| ch == '-' || ch == ':')) {
+                continue;
+            }
+            if !in_table {
+                out.push_str("<table>\n");
+                in_table = true;
+                header = true;
+            }
+            let tag = if header { "th" } else { "td" };
+            out.push_str("<tr>");
+            for c in cells {
+                let _ = write!(out, "<{tag}>{}</{tag}>", escape(c));
+            }
+            out.push_str("</tr>\n");
+            header = false;
+        } else {
+            if in_table {
+                out.push_str("</table>\n");
+                in_table = false;
+            }
+            if !line.is_empty() && !line.starts_with('#') {
+                let _ = writeln!(out, "<p>{}</p>", escape(line));
+            }
+        }
+    }
+    if in_table {
+        out.push_str("</table>\n");
+    }
+    out
+}
+
+/// Write `index.html` under `dir` atomically.
+pub fn write_index(dir: &Path, page: &str) -> Result<PathBuf, HarnessError> {
+    let path = dir.join("index.html");
+    meshes::io::atomic_write(&path, |w| w.write_all(page.as_bytes()).map_err(meshes::MeshError::from))?;
+    Ok(path)
+}

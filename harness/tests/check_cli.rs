@@ -1,0 +1,80 @@
+//! The regression gate through the `harness` binary: `baseline` writes a baseline from a run's
+//! results.json, `check` passes on the same results and fails, naming the case and metric, once one
+//! result is made worse on purpose; a failed case and a missing case fail it too.
+
+use std::path::Path;
+use std::process::Command;
+
+/// A results.json as a run writes it, with the given `(scenario, method, e_theta, e_phi, status)`.
+fn write_results(dir: &Path, cases: &[(&str, &str, f64, f64, &str)]) {
+    let cases: Vec<serde_json::Value> = cases
+        .iter()
+        .map(|(scenario, method, e_theta, e_phi, status)| {
+            serde_json::json!({
+                "scenario": scenario, "method": method, "mesh_source": "survey", "vertices": 10, "faces": 16,
+                "precompute_s": 0.1, "bind_s": 0.01, "median_iteration_ms": 1.0, "iterations": 5, "solve_s": 0.2,
+                "total_s": 0.3, "converged": true, "e_theta_deg": e_theta, "e_phi_deg": e_phi,
+                "handle_residual_over_diag": 0.0, "rms_to_arap_over_diag": null, "status": status,
+                "phase_timings": [], "statistics": [], "steps": [], "trace": []
+            })
+        })
+        .collect();
+    let report =
+        serde_json::json!({ "generator": "test", "data_source": "survey data", "units": "", "cases": cases });
+    std::fs::write(dir.join("results.json"), serde_json::to_vec_pretty(&report).unwrap()).unwrap();
+}
+
+fn harness(args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_harness")).args(args).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    (out.status.code().unwrap_or(-1), text)
+}
+
+#[test]
+fn check_names_every_regression_and_passes_identical_results() {
+    let dir = tempfile::tempdir().unwrap();
+    let reports = dir.path().to_str().unwrap();
+    let baseline = dir.path().join("baseline.json");
+    let baseline = baseline.to_str().unwrap();
+    let good = [
+        ("bar", "arap", 2.1151, 5.7769, "ok"),
+        ("cactus", "arap", 1.1910, 2.7614, "ok"),
+        ("cactus", "hirm", 6.29, 0.93, "ok"),
+    ];
+    write_results(dir.path(), &good);
+
+    let (code, text) = harness(&["baseline", "--reports", reports, "--baseline", baseline]);
+    assert_eq!(code, 0, "{text}");
+    let (code, text) = harness(&["check", "--reports", reports, "--baseline", baseline]);
+    assert_eq!(code, 0, "{text}");
+    assert!(text.contains("no quality regression"), "{text}");
+
+    // Worsen cactus/arap E_theta by 10% on purpose.
+    let mut worse = good;
+    worse[1].2 *= 1.1;
+    write_results(dir.path(), &worse);
+    let (code, text) = harness(&["check", "--reports", reports, "--baseline", baseline]);
+    assert_eq!(code, 3, "{text}");
+    assert!(text.contains("cactus / arap / e_theta_deg"), "{text}");
+    assert!(!text.contains("bar / arap"), "only the worsened case is named: {text}");
+
+    // A failed case and a case missing from the run.
+    write_results(dir.path(), &[good[0], ("cactus", "arap", f64::NAN, f64::NAN, "failed: linear solver")]);
+    let (code, text) = harness(&["check", "--reports", reports, "--baseline", baseline]);
+    assert_eq!(code, 3, "{text}");
+    assert!(text.contains("failed: cactus / arap"), "{text}");
+    assert!(text.contains("missing: cactus / hirm"), "{text}");
+}
+
+#[test]
+fn check_without_results_or_baseline_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let reports = dir.path().to_str().unwrap();
+    let (code, text) = harness(&["check", "--reports", reports, "--baseline", "/nonexistent/baseline.json"]);
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains("results.json"), "{text}");
+    write_results(dir.path(), &[("bar", "arap", 1.0, 1.0, "ok")]);
+    let (code, text) = harness(&["check", "--reports", reports, "--baseline", "/nonexistent/baseline.json"]);
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains("/nonexistent/baseline.json"), "{text}");
+}
