@@ -87,6 +87,19 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
         let (fine, coarse) = (num(bar("isolines"), key), num(bar("isolines_10"), key));
         assert!(fine <= coarse, "bar: {key} with 20 isolines {fine} > with 10 {coarse}");
     }
+    // The standard suite ends with the regression gate (the exit code above says it passed) and
+    // a page with every plot and figure.
+    let page = std::fs::read_to_string(reports.path().join("index.html")).unwrap();
+    assert!(page.contains("No regression against"), "regression verdict missing from index.html");
+    for plot in ["scaling", "table1", "cactus-errors", "cactus-timings", "cactus-convergence"] {
+        assert!(reports.path().join(format!("plots/{plot}.png")).is_file(), "missing plots/{plot}.png");
+    }
+    for scenario in ["bar", "cactus", "cylinder", "plane"] {
+        for method in methods::registry::method_names() {
+            let render = reports.path().join(format!("figures/{scenario}-{method}.png"));
+            assert!(render.is_file(), "missing {}", render.display());
+        }
+    }
     let json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(reports.path().join("results.json")).unwrap()).unwrap();
     let cases = json["cases"].as_array().unwrap();
@@ -194,6 +207,85 @@ fn without_survey_data_the_procedural_look_alikes_run_and_are_labelled() {
     }
     let json = std::fs::read_to_string(reports.path().join("results.json")).unwrap();
     assert!(json.contains("procedural look-alikes"));
+
+    // Plots per test, and the page that shows everything, checked in a real browser.
+    for shape in ["bar", "cylinder", "cactus", "plane"] {
+        for plot in ["errors", "timings", "convergence"] {
+            for ext in ["png", "svg"] {
+                let path = reports.path().join(format!("plots/{shape}-{plot}.{ext}"));
+                assert!(path.is_file(), "missing {}", path.display());
+            }
+        }
+    }
+    for figure in ["grid", "grid_heat", "bar-rest", "bar-arap", "bar-arap-heat"] {
+        assert!(
+            reports.path().join(format!("figures/{figure}.png")).is_file(),
+            "missing figures/{figure}.png"
+        );
+    }
+    let index = reports.path().join("index.html");
+    let page = std::fs::read_to_string(&index).unwrap();
+    assert!(page.contains("Not checked"), "a procedural run is not compared with the survey baseline");
+    let Some(chromium) = chromium() else { return };
+    let (loaded, total) = images_loaded_in_chromium(&chromium, &index);
+    let expected = page.matches("<img ").count();
+    assert!(expected >= 12, "index.html links {expected} images");
+    assert_eq!((loaded, total), (expected, expected), "images loaded / present in index.html");
+}
+
+/// Debian's headless Chromium: `$DEFORMBENCH_CHROMIUM`, else `/usr/bin/chromium` (installed by
+/// `.ci/run`); a failure under `scripts/test` when missing, a skip otherwise.
+fn chromium() -> Option<PathBuf> {
+    let path = std::env::var_os("DEFORMBENCH_CHROMIUM")
+        .map_or_else(|| PathBuf::from("/usr/bin/chromium"), PathBuf::from);
+    if path.is_file() {
+        return Some(path);
+    }
+    if std::env::var("DEFORMBENCH_REQUIRE_CROSSCHECK").is_ok_and(|v| v == "1") {
+        panic!(
+            "{} not found: install Debian's chromium (see .ci/run) or set DEFORMBENCH_CHROMIUM",
+            path.display()
+        );
+    }
+    eprintln!("SKIPPED: no Chromium at {}", path.display());
+    None
+}
+
+/// Open `page` in headless Chromium and read the count its script writes into `#image-check`:
+/// `(images loaded, images on the page)`.
+fn images_loaded_in_chromium(chromium: &Path, page: &Path) -> (usize, usize) {
+    let profile = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--allow-file-access-from-files",
+            "--virtual-time-budget=10000",
+        ])
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .arg("--dump-dom")
+        .arg(format!("file://{}", page.canonicalize().unwrap().display()))
+        .output()
+        .expect("run chromium");
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let check = dom.split("<p id=\"image-check\"").nth(1).unwrap_or_else(|| {
+        panic!("no #image-check in the DOM; chromium said: {}", String::from_utf8_lossy(&out.stderr))
+    });
+    let attribute = |name: &str| -> usize {
+        let value = check.split(&format!("{name}=\"")).nth(1).and_then(|v| v.split('"').next()).unwrap_or("");
+        value
+            .parse()
+            .unwrap_or_else(|_| panic!("#image-check {name} = {value:?} (the page script did not run)"))
+    };
+    let broken = check.split("data-broken=\"").nth(1).and_then(|v| v.split('"').next()).unwrap_or("");
+    assert!(broken.is_empty(), "images that did not load: {broken}");
+    (attribute("data-loaded"), attribute("data-total"))
 }
 
 /// A tiny survey-format data set (procedural bar written as .off/.sel/.def) and a configs directory
