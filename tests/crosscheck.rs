@@ -184,3 +184,282 @@ fn manifold_harmonics_match_scipy_eigsh() {
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------------------
+// Peer cross-checks with pymeshlab and open3d (tests/crosscheck/peers_reference.py).
+
+use support::peers_reference;
+
+/// Writes the `index x y z` constraints file (igl_reference.py `arap` / peers_reference.py
+/// `open3d_arap` format) of a survey edit.
+fn write_constraints(path: &std::path::Path, handles: &methods::HandleSet, targets: &methods::HandleTargets) {
+    let lines: String = handles
+        .constrained()
+        .zip(targets.positions())
+        .map(|(v, t)| format!("{v} {:e} {:e} {:e}\n", t[0], t[1], t[2]))
+        .collect();
+    std::fs::write(path, lines).unwrap();
+}
+
+/// Our `arap` after exactly `iterations` iterations (no early exit), from the rest shape.
+fn our_arap(
+    mesh: &meshes::TriMesh,
+    handles: &methods::HandleSet,
+    targets: &methods::HandleTargets,
+    iterations: usize,
+) -> Vec<[f64; 3]> {
+    let params: toml::Table = format!("max_iterations = {iterations}\ntolerance = 0.0").parse().unwrap();
+    let mut arap = methods::registry::create("arap", &params).unwrap();
+    arap.precompute(mesh).unwrap();
+    arap.bind_handles(handles).unwrap();
+    let summary = arap.solve(targets, &mut NoObserver).unwrap();
+    assert_eq!(summary.iterations, iterations);
+    arap.positions()
+}
+
+/// Largest vertex distance between two `#V x 3` arrays.
+fn max_vertex_distance(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt())
+        .fold(0.0, f64::max)
+}
+
+fn json_f64(v: &serde_json::Value, path: &[&str]) -> f64 {
+    let mut cur = v;
+    for key in path {
+        cur = &cur[*key];
+    }
+    cur.as_f64().unwrap_or_else(|| panic!("no number at {path:?} in {v}"))
+}
+
+/// Our corner angles and face areas against pymeshlab's (per-face quality filters, evaluated by MeshLab
+/// in double precision; see peers_reference.py `face_measures`). Both evaluate
+/// atan2(|e1 x e2|, e1 . e2) and |e1 x e2| / 2 in f64, so they agree to rounding: measured max
+/// |angle difference| 2.2e-16 rad (cactus; 0 on cylinder and bar, 1.1e-16 on plane), max relative
+/// area difference 0 on all four. Bound 1e-12 (rad, relative): a few thousand ulps, far below any
+/// real difference in formula, corner order or vertex indexing.
+#[test]
+fn peers_corner_angles_and_face_areas_match_pymeshlab() {
+    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    for name in MESHES {
+        let mesh_path = dir.join(format!("{name}.off"));
+        let mesh = meshes::io::read_mesh(&mesh_path).unwrap();
+        let out = tempfile::tempdir().unwrap();
+        peers_reference(&py, &["face_measures", mesh_path.to_str().unwrap(), out.path().to_str().unwrap()]);
+
+        // Same faces, in the same order and with the same corner order, or nothing below is comparable.
+        let faces: Vec<[u32; 3]> = read_rows(&out.path().join("faces.txt"))
+            .into_iter()
+            .map(|r| [r[0] as u32, r[1] as u32, r[2] as u32])
+            .collect();
+        assert_eq!(faces, mesh.triangles(), "{name}: pymeshlab's faces differ from the file's");
+
+        let theirs_angles = read_rows(&out.path().join("angles.txt"));
+        let theirs_areas: Vec<f64> =
+            read_rows(&out.path().join("areas.txt")).into_iter().map(|r| r[0]).collect();
+        let ours_angles = meshes::geometry::corner_angles(mesh.positions(), mesh.triangles());
+        let ours_areas = meshes::geometry::face_areas(mesh.positions(), mesh.triangles());
+        assert_eq!(theirs_angles.len(), ours_angles.len());
+        assert_eq!(theirs_areas.len(), ours_areas.len());
+        let angle_err = ours_angles
+            .iter()
+            .zip(&theirs_angles)
+            .flat_map(|(a, b)| (0..3).map(move |k| (a[k] - b[k]).abs()))
+            .fold(0.0, f64::max);
+        let area_err =
+            ours_areas.iter().zip(&theirs_areas).map(|(a, b)| (a - b).abs() / b.abs()).fold(0.0, f64::max);
+        println!("{name}: corner angles max abs difference {angle_err:.2e} rad, face areas max relative difference {area_err:.2e}");
+        assert!(angle_err <= 1e-12, "{name}: corner angles differ from pymeshlab's by {angle_err:e} rad");
+        assert!(area_err <= 1e-12, "{name}: face areas differ from pymeshlab's by {area_err:e} (relative)");
+    }
+}
+
+/// Survey edits and iteration counts of the ARAP peer checks. The plane (40K vertices) only at 10
+/// iterations: 100 would take libigl 12 s and open3d 26 s (0.26 s per open3d iteration).
+const ARAP_CASES: [(&str, &[usize]); 4] =
+    [("cylinder", &[10, 100]), ("bar", &[10, 100]), ("cactus", &[10, 100]), ("plane", &[10])];
+
+/// Symmetric Hausdorff distance (pymeshlab) between our `arap` and libigl's SPOKES ARAP surfaces on the
+/// survey edits, same constraints and iteration counts as `arap_matches_libigl_arap_solve`.
+///
+/// Measured (Hausdorff / bbox diagonal at 10 and 100 iterations): cylinder 2.9e-5, 4.4e-5; bar
+/// 1.0e-5, 1.6e-5; cactus 5.4e-6, 3.5e-5; plane (10 only) 6.2e-4. The gap is libigl's: its rotation
+/// fit is single precision (igl_reference.py's docstring) and grows over the iterations. On the plane's
+/// flat one-rings the covariances are nearly rank 2, which the float SVD resolves worst: a
+/// double-precision numpy SPOKES ARAP (written while setting this test up; it matches ours) is as far
+/// from libigl there, 6.2e-4 max vertex distance / diagonal after 10 iterations (7.7e-3 after 100).
+/// Bounds: 1e-4 of the diagonal (2.3x the largest figure) on the three 5-6K-vertex meshes, 1e-3 (the
+/// RMS bound of the libigl test; 1.6x) on the plane. Also asserted: Hausdorff <= max vertex distance.
+#[test]
+fn peers_arap_hausdorff_distance_to_libigl_arap_is_small() {
+    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    for (name, iteration_counts) in ARAP_CASES {
+        let (mesh, handles, targets) = survey_case(&dir, name);
+        let diagonal = mesh.bbox_diagonal();
+        let work = tempfile::tempdir().unwrap();
+        let constraints = work.path().join("constraints.txt");
+        write_constraints(&constraints, &handles, &targets);
+        let mesh_path = dir.join(format!("{name}.off"));
+        for &iterations in iteration_counts {
+            let igl_out = work.path().join(format!("igl{iterations}.txt"));
+            igl_reference(
+                &py,
+                &[
+                    "arap",
+                    mesh_path.to_str().unwrap(),
+                    constraints.to_str().unwrap(),
+                    &iterations.to_string(),
+                    igl_out.to_str().unwrap(),
+                ],
+            );
+            let theirs: Vec<[f64; 3]> = read_rows(&igl_out).into_iter().map(|r| [r[0], r[1], r[2]]).collect();
+            let ours = our_arap(&mesh, &handles, &targets, iterations);
+            let ours_off = work.path().join(format!("ours{iterations}.off"));
+            let theirs_off = work.path().join(format!("igl{iterations}.off"));
+            meshes::io::write_off(&ours_off, &mesh.with_positions(ours.clone()).unwrap()).unwrap();
+            meshes::io::write_off(&theirs_off, &mesh.with_positions(theirs.clone()).unwrap()).unwrap();
+            let report: serde_json::Value = serde_json::from_str(&peers_reference(
+                &py,
+                &["hausdorff", ours_off.to_str().unwrap(), theirs_off.to_str().unwrap()],
+            ))
+            .unwrap();
+            let hausdorff = json_f64(&report, &["hausdorff"]) / diagonal;
+            let max_vertex = max_vertex_distance(&ours, &theirs) / diagonal;
+            println!(
+                "{name}: {iterations} iterations, Hausdorff(ours, libigl) / bbox diagonal = {hausdorff:.2e} (ours->libigl {:.2e}, libigl->ours {:.2e}), max vertex distance / diagonal = {max_vertex:.2e}",
+                json_f64(&report, &["a_to_b", "max"]) / diagonal,
+                json_f64(&report, &["b_to_a", "max"]) / diagonal,
+            );
+            // Same connectivity, so every point of one surface has a point of the other within the
+            // largest vertex distance: pymeshlab's figure cannot exceed it (slack for its
+            // single-precision rounding of the result).
+            assert!(
+                hausdorff <= max_vertex * (1.0 + 1e-6) + 1e-9,
+                "{name}: Hausdorff {hausdorff:e} exceeds the max vertex distance {max_vertex:e}"
+            );
+            let bound = if name == "plane" { 1e-3 } else { 1e-4 };
+            assert!(
+                hausdorff <= bound,
+                "{name}: after {iterations} iterations ours is {hausdorff:e} x diagonal from libigl's surface"
+            );
+        }
+    }
+}
+
+/// open3d's `deform_as_rigid_as_possible` (energy Spokes) against our `arap`, same constraints, same
+/// iteration count, both from the rest shape.
+///
+/// open3d 0.20 (TriangleMeshDeformation.cpp) is SA07 spokes ARAP with two differences that cannot be
+/// switched off from Python: (1) edge weights are the mean of the opposite cotangents clamped at 0, so
+/// boundary edges get cot a instead of our cot a / 2, and negative weights become 0; (2) its first
+/// local step sees the rest shape with the constrained vertices NOT yet moved (all rotations identity,
+/// iteration 1 = plain Laplacian editing), where we (like libigl) move them to their targets first. A
+/// numpy reimplementation with both changes reproduced open3d to 4e-13 x diagonal (max) over 1000
+/// iterations on the cylinder; the same code with our weights and start reproduces ours (7e-13 after
+/// 100). On the survey meshes: cylinder is closed with no negative weight (only (2) applies), cactus
+/// has one clamped edge, bar 360 clamped and 60 boundary edges, plane 7744 and 800. ARAP converges
+/// slowly, so (2) alone leaves the cylinder 1.3e-2 RMS apart after 1 iteration, 8.1e-3 after 10,
+/// 6.3e-3 after 100, 1.8e-2 after 300 and 2.8e-4 after 1000: the two approach the same minimum, not
+/// monotonically, and no iteration count affordable here makes them agree closely. Where the weights
+/// differ the minima differ too (plane, 100 iterations, not run here for its 26 s: 2.1e-2 RMS).
+///
+/// Measured (RMS / diagonal, max / diagonal, RMS / our RMS displacement from rest), 10 | 100 iterations:
+/// cylinder 8.1e-3, 3.5e-2, 0.020 | 6.3e-3, 1.9e-2, 0.016; bar 2.3e-3, 9.8e-3, 0.033 | 5.0e-4,
+/// 2.1e-3, 0.006; cactus 7.3e-3, 3.5e-2, 0.041 | 1.2e-3, 3.7e-3, 0.008; plane (10 only) 4.7e-3,
+/// 1.4e-2, 0.018. Asserted: open3d meets its constraints (measured <= 1.1e-15 x diagonal, bound 1e-12),
+/// RMS <= 2e-2 x diagonal (2.5x the largest) and RMS <= 0.1 x our RMS displacement (2.4x the largest):
+/// the two reproduce the same deformation to within a tenth of its size, not closer.
+#[test]
+fn peers_arap_agrees_with_open3d_arap() {
+    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    for (name, iteration_counts) in ARAP_CASES {
+        let (mesh, handles, targets) = survey_case(&dir, name);
+        let diagonal = mesh.bbox_diagonal();
+        let work = tempfile::tempdir().unwrap();
+        let constraints = work.path().join("constraints.txt");
+        write_constraints(&constraints, &handles, &targets);
+        let mesh_path = dir.join(format!("{name}.off"));
+        for &iterations in iteration_counts {
+            let out = work.path().join(format!("open3d{iterations}.off"));
+            peers_reference(
+                &py,
+                &[
+                    "open3d_arap",
+                    mesh_path.to_str().unwrap(),
+                    constraints.to_str().unwrap(),
+                    out.to_str().unwrap(),
+                    "--iterations",
+                    &iterations.to_string(),
+                ],
+            );
+            let theirs = meshes::io::read_mesh(&out).unwrap();
+            assert_eq!(theirs.triangles(), mesh.triangles());
+            let theirs = theirs.positions();
+            let ours = our_arap(&mesh, &handles, &targets, iterations);
+            let rms = harness::metrics::rms_distance(&ours, theirs, diagonal);
+            let max = max_vertex_distance(&ours, theirs) / diagonal;
+            let moved = harness::metrics::rms_distance(&ours, mesh.positions(), diagonal);
+            let residual = harness::metrics::handle_residual(&handles, &targets, theirs, diagonal);
+            println!(
+                "{name}: {iterations} iterations, open3d vs ours / bbox diagonal: RMS {rms:.2e}, max {max:.2e}; RMS / our RMS displacement {:.3}; open3d handle residual {residual:.1e}",
+                rms / moved
+            );
+            assert!(residual <= 1e-12, "{name}: open3d misses its constraints by {residual:e} x diagonal");
+            assert!(rms <= 2e-2, "{name}, {iterations} iterations: RMS {rms:e} x diagonal");
+            assert!(
+                rms <= 0.1 * moved,
+                "{name}, {iterations} iterations: RMS gap {rms:e} is more than 0.1 of the RMS displacement {moved:e}"
+            );
+        }
+    }
+}
+
+/// open3d's `is_self_intersecting`: false on the four rest survey meshes, true on two triangles that
+/// cross, false on the same two moved apart. (open3d tests all pairs of triangles: 25 s of this test's
+/// ~28 s is the 80K-face plane.)
+#[test]
+fn peers_open3d_self_intersection_flags_only_the_crossing_mesh() {
+    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    let work = tempfile::tempdir().unwrap();
+    // Two triangles with no shared vertex: the second pierces the first's interior along the segment
+    // (0.5, 0.5, 0)-(1, 0.25, 0); moved 5 along x it is clear of it.
+    let first = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]];
+    let second = [[0.5, 0.5, -1.0], [0.5, 0.5, 1.0], [1.0, 0.25, 0.0]];
+    let moved = second.map(|p| [p[0] + 5.0, p[1], p[2]]);
+    let crossing_path = work.path().join("crossing.off");
+    let apart_path = work.path().join("apart.off");
+    for (path, other) in [(&crossing_path, second), (&apart_path, moved)] {
+        let positions: Vec<[f64; 3]> = first.iter().chain(other.iter()).copied().collect();
+        let mesh = meshes::TriMesh::new(positions, vec![[0, 1, 2], [3, 4, 5]]).unwrap();
+        meshes::io::write_off(path, &mesh).unwrap();
+    }
+    let mut paths: Vec<std::path::PathBuf> = MESHES.iter().map(|n| dir.join(format!("{n}.off"))).collect();
+    paths.push(crossing_path.clone());
+    paths.push(apart_path.clone());
+    let mut args = vec!["self_intersecting"];
+    args.extend(paths.iter().map(|p| p.to_str().unwrap()));
+    let out = peers_reference(&py, &args);
+    let verdicts: HashMap<String, bool> = out
+        .lines()
+        .map(|line| {
+            let (path, flag) = line.rsplit_once(',').unwrap_or_else(|| panic!("bad line {line:?}"));
+            (
+                path.to_string(),
+                match flag {
+                    "true" => true,
+                    "false" => false,
+                    _ => panic!("bad flag in {line:?}"),
+                },
+            )
+        })
+        .collect();
+    assert_eq!(verdicts.len(), paths.len(), "one line per mesh expected:\n{out}");
+    for path in &paths {
+        let expected = *path == crossing_path;
+        let got = verdicts[path.to_str().unwrap()];
+        println!("{}: is_self_intersecting = {got}", path.file_name().unwrap().to_string_lossy());
+        assert_eq!(got, expected, "{}: open3d is_self_intersecting = {got}", path.display());
+    }
+}

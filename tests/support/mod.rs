@@ -72,3 +72,16 @@ pub fn survey_case(dir: &Path, name: &str) -> (meshes::TriMesh, methods::HandleS
     let (handles, targets) = harness::scenario::survey_edit(&mesh, &sel, &def).expect("edit");
     (mesh, handles, targets)
 }
+
+/// Run `tests/crosscheck/peers_reference.py` (pymeshlab/open3d references) with `args`; panics with its
+/// stderr on failure. Returns stdout.
+pub fn peers_reference(python: &Path, args: &[&str]) -> String {
+    let script = workspace_root().join("tests/crosscheck/peers_reference.py");
+    let out = Command::new(python).arg(&script).args(args).output().expect("run python");
+    assert!(
+        out.status.success(),
+        "peers_reference.py {args:?} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("utf-8")
+}
