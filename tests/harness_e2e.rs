@@ -189,21 +189,36 @@ fn without_survey_data_the_procedural_look_alikes_run_and_are_labelled() {
         )
         .unwrap();
     }
-    let code = run(&[
+    // With the cross-check Python, every result is also checked for self-intersections by open3d
+    // (the small look-alikes keep that quick).
+    let python = support::python();
+    let mut args = vec![
         "all",
         "--quiet",
         "--configs",
         configs.path().to_str().unwrap(),
         "--reports",
         reports.path().to_str().unwrap(),
-    ])
-    .unwrap();
+    ];
+    if let Some(python) = &python {
+        args.extend(["--self-intersections", "--python", python.to_str().unwrap()]);
+    }
+    let code = run(&args).unwrap();
     assert_eq!(code, std::process::ExitCode::SUCCESS);
     let rows = csv_rows(&reports.path().join("results.csv"));
     assert_eq!(rows.len(), 4 * methods::registry::METHODS.len());
     for row in &rows {
         assert_eq!(row["mesh_source"], "procedural look-alike");
         assert_eq!(row["status"], "ok", "{}/{}", row["scenario"], row["method"]);
+        if python.is_some() {
+            let answer = row["self_intersecting"].as_str();
+            assert!(
+                answer == "true" || answer == "false",
+                "{}/{}: self_intersecting {answer:?}",
+                row["scenario"],
+                row["method"]
+            );
+        }
     }
     let json = std::fs::read_to_string(reports.path().join("results.json")).unwrap();
     assert!(json.contains("procedural look-alikes"));

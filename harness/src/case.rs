@@ -82,6 +82,10 @@ pub struct CaseResult {
     pub handle_residual_over_diag: f64,
     /// Filled in once the scenario's `arap` result is known.
     pub rms_to_arap_over_diag: Option<f64>,
+    /// open3d's `is_self_intersecting` of the result, when the run asked for it
+    /// (`--self-intersections`).
+    #[serde(default)]
+    pub self_intersecting: Option<bool>,
     /// `ok`, or `failed: <reason>`.
     pub status: String,
     /// Method-specific phases (e.g. HIRM's t_e, t_b) in seconds, after the last step.
@@ -156,6 +160,7 @@ pub fn run_case(
         e_phi_deg: f64::NAN,
         handle_residual_over_diag: f64::NAN,
         rms_to_arap_over_diag: None,
+        self_intersecting: None,
         status: String::new(),
         phase_timings: Vec::new(),
         statistics: Vec::new(),

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use crate::scenario::load_specs;
 use crate::suite::{self, SuiteOptions, SURVEY_DIR_ENV};
-use crate::{html, plots, regression, render, report};
+use crate::{html, peers, plots, regression, render, report};
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
 
@@ -29,6 +29,8 @@ enum Command {
         #[command(flatten)]
         common: Common,
         #[command(flatten)]
+        peers: Peers,
+        #[command(flatten)]
         gate: Gate,
         /// Skip the regression check.
         #[arg(long)]
@@ -44,6 +46,8 @@ enum Command {
         scenario: String,
         #[command(flatten)]
         common: Common,
+        #[command(flatten)]
+        peers: Peers,
     },
     /// Compare reports/results.json with the baseline; exit non-zero naming every regression.
     Check {
@@ -62,6 +66,35 @@ enum Command {
     },
     /// List the registered methods and the scenarios.
     List(Common),
+}
+
+#[derive(Args, Clone)]
+struct Peers {
+    /// Check every result for self-intersections with open3d (slow on large meshes: ~25 s per
+    /// result on the bumpy plane) and report it in the `self_intersecting` column.
+    #[arg(long)]
+    self_intersections: bool,
+    /// The cross-check Python with open3d (`scripts/python-env` prints it).
+    #[arg(long, env = peers::PYTHON_ENV)]
+    python: Option<PathBuf>,
+}
+
+impl Peers {
+    /// The Python to run the peer checks with, if they were asked for.
+    fn python(&self) -> anyhow::Result<Option<PathBuf>> {
+        if !self.self_intersections {
+            return Ok(None);
+        }
+        match &self.python {
+            Some(p) if p.is_file() => Ok(Some(p.clone())),
+            Some(p) => anyhow::bail!("--python {}: no such file", p.display()),
+            None => anyhow::bail!(
+                "--self-intersections needs the cross-check Python with open3d: give --python or set {} \
+                 (scripts/python-env sets it up and prints its path)",
+                peers::PYTHON_ENV
+            ),
+        }
+    }
 }
 
 #[derive(Args, Clone)]
@@ -124,7 +157,7 @@ where
 {
     let cli = Cli::parse_from(args);
     match cli.command {
-        Command::All { common, gate, no_check } => {
+        Command::All { common, peers, gate, no_check } => {
             let options = common.options(Vec::new(), Vec::new());
             let default_configs = suite::workspace_root().join("configs");
             let same = |a: &std::path::Path, b: &std::path::Path| {
@@ -137,11 +170,13 @@ where
             } else {
                 Ok(gate.path())
             };
-            execute(&options, gate)
+            execute(&options, peers.python()?, gate)
         }
-        Command::Run { methods, scenario, common } => {
-            execute(&common.options(vec![scenario], methods), Err("`run` covers one scenario".to_string()))
-        }
+        Command::Run { methods, scenario, common, peers } => execute(
+            &common.options(vec![scenario], methods),
+            peers.python()?,
+            Err("`run` covers one scenario".to_string()),
+        ),
         Command::Check { common, gate } => {
             let dir = common.options(Vec::new(), Vec::new()).reports_dir;
             let (results, _) = regression::read_results(&dir.join("results.json"))?;
@@ -149,9 +184,8 @@ where
             let foreign = regression::foreign_cases(&baseline, &results);
             if !foreign.is_empty() {
                 anyhow::bail!(
-                    "{}: the baseline is for {} data; these cases ran on other data: {}",
+                    "{}: these cases ran on other data than the baseline's: {}",
                     gate.path().display(),
-                    baseline.mesh_source,
                     foreign.join(", ")
                 );
             }
@@ -205,9 +239,21 @@ fn print_findings(findings: &[regression::Finding], baseline: &std::path::Path) 
     }
 }
 
-/// Run the suite, write every report, and compare with the baseline at `gate` (or say why not).
-fn execute(options: &SuiteOptions, gate: Result<PathBuf, String>) -> anyhow::Result<ExitCode> {
-    let run = suite::run(options).context("preparing the run")?;
+/// Run the suite, check the results with open3d when `peer_python` is given, write every report,
+/// and compare with the baseline at `gate` (or say why not).
+fn execute(
+    options: &SuiteOptions,
+    peer_python: Option<PathBuf>,
+    gate: Result<PathBuf, String>,
+) -> anyhow::Result<ExitCode> {
+    let mut run = suite::run(options).context("preparing the run")?;
+    if let Some(python) = peer_python {
+        let answers = peers::self_intersections(&python, &run.results, &run.scenarios)
+            .context("self-intersection check (open3d)")?;
+        for (r, answer) in run.results.iter_mut().zip(answers) {
+            r.self_intersecting = answer;
+        }
+    }
     let dir = &options.reports_dir;
     report::write_reports(dir, &run.results, &run.scenarios, &run.data_source).context("writing reports")?;
     let mut images = plots::write_plots(dir, &run.results).context("writing plots")?;
@@ -220,7 +266,7 @@ fn execute(options: &SuiteOptions, gate: Result<PathBuf, String>) -> anyhow::Res
             if foreign.is_empty() {
                 Ok((path, regression::check(&baseline, &run.results)))
             } else {
-                Err(format!("the baseline is for {} data, this run is not", baseline.mesh_source))
+                Err(format!("the run used other data than the baseline for {}", foreign.join(", ")))
             }
         }
         Ok(path) => Err(format!("no baseline at {} (write one with `harness baseline`)", path.display())),

@@ -92,14 +92,14 @@ pub fn render_index(
     page.push_str("<h2 id=\"results\">Results</h2>\n<table>\n<tr><th>scenario</th><th>method</th><th>#V</th>\
                    <th>E_θ</th><th>E_φ</th><th>iterations</th><th>converged</th><th>precompute</th><th>bind</th>\
                    <th>solve</th><th>total</th><th>iteration (ms)</th><th>residual</th><th>RMS to arap</th>\
-                   <th>status</th></tr>\n");
+                   <th>self-intersecting (open3d)</th><th>status</th></tr>\n");
     for r in results {
         let class = if r.status == "ok" { "" } else { " class=\"failed\"" };
         let _ = writeln!(
             page,
             "<tr{class}><td class=\"text\">{}</td><td class=\"text\">{}</td><td>{}</td><td>{}</td><td>{}</td>\
              <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>\
-             <td class=\"text\">{}</td></tr>",
+             <td>{}</td><td class=\"text\">{}</td></tr>",
             escape(&r.scenario),
             escape(&r.method),
             r.vertices,
@@ -114,6 +114,7 @@ pub fn render_index(
             number(r.median_iteration_ms, 3),
             if r.handle_residual_over_diag.is_finite() { format!("{:.1e}", r.handle_residual_over_diag) } else { "–".into() },
             r.rms_to_arap_over_diag.map_or("–".into(), |v| format!("{v:.1e}")),
+            r.self_intersecting.map_or("not checked", |b| if b { "yes" } else { "no" }),
             escape(&r.status),
         );
     }

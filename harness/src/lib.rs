@@ -8,6 +8,7 @@ pub mod error;
 pub mod fonts;
 pub mod html;
 pub mod metrics;
+pub mod peers;
 pub mod plots;
 pub mod regression;
 pub mod render;

@@ -32,6 +32,9 @@ impl Default for Tolerance {
 pub struct BaselineCase {
     pub scenario: String,
     pub method: String,
+    /// `survey` or `procedural look-alike` (the `mesh_source` column): a run of the same case on
+    /// other data is not compared.
+    pub mesh_source: String,
     pub e_theta_deg: f64,
     pub e_phi_deg: f64,
 }
@@ -39,9 +42,6 @@ pub struct BaselineCase {
 /// Contents of `reports/baseline.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Baseline {
-    /// The mesh source the baseline was measured on (`survey` or `procedural look-alike`, the
-    /// `mesh_source` column); a run on other data is not compared.
-    pub mesh_source: String,
     pub tolerance: Tolerance,
     pub cases: Vec<BaselineCase>,
 }
@@ -108,7 +108,6 @@ impl fmt::Display for Finding {
 /// A baseline from the cases of a run that have a result (failed cases are left out).
 pub fn baseline_from(results: &[CaseResult]) -> Baseline {
     Baseline {
-        mesh_source: results.first().map(|r| r.mesh_source.clone()).unwrap_or_default(),
         tolerance: Tolerance::default(),
         cases: results
             .iter()
@@ -116,6 +115,7 @@ pub fn baseline_from(results: &[CaseResult]) -> Baseline {
             .map(|r| BaselineCase {
                 scenario: r.scenario.clone(),
                 method: r.method.clone(),
+                mesh_source: r.mesh_source.clone(),
                 e_theta_deg: r.e_theta_deg,
                 e_phi_deg: r.e_phi_deg,
             })
@@ -123,13 +123,18 @@ pub fn baseline_from(results: &[CaseResult]) -> Baseline {
     }
 }
 
-/// The cases of `results` measured on other data than `baseline` (by `mesh_source`), as
-/// `scenario / method (mesh source)`; a comparison across data sources means nothing.
+/// The cases of `results` measured on other data than the same case of `baseline` (by
+/// `mesh_source`), as `scenario / method (run's source, baseline's source)`; a comparison across
+/// data sources means nothing.
 pub fn foreign_cases(baseline: &Baseline, results: &[CaseResult]) -> Vec<String> {
     results
         .iter()
-        .filter(|r| r.mesh_source != baseline.mesh_source)
-        .map(|r| format!("{} / {} ({})", r.scenario, r.method, r.mesh_source))
+        .filter_map(|r| {
+            let b = baseline.cases.iter().find(|b| b.scenario == r.scenario && b.method == r.method)?;
+            (b.mesh_source != r.mesh_source).then(|| {
+                format!("{} / {} ({}, baseline: {})", r.scenario, r.method, r.mesh_source, b.mesh_source)
+            })
+        })
         .collect()
 }
 

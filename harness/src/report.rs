@@ -29,6 +29,7 @@ pub const CSV_COLUMNS: &[&str] = &[
     "e_phi_deg",
     "handle_residual_over_diag",
     "rms_to_arap_over_diag",
+    "self_intersecting",
     "status",
 ];
 
@@ -72,6 +73,7 @@ pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
             num(r.e_phi_deg),
             num(r.handle_residual_over_diag),
             r.rms_to_arap_over_diag.map(num).unwrap_or_default(),
+            r.self_intersecting.map(|b| b.to_string()).unwrap_or_default(),
             r.status.clone(),
         ])
         .map_err(err)?;

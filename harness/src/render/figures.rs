@@ -484,6 +484,7 @@ mod tests {
             e_phi_deg: f64::NAN,
             handle_residual_over_diag: 0.0,
             rms_to_arap_over_diag: None,
+            self_intersecting: None,
             status: status.into(),
             phase_timings: Vec::new(),
             statistics: Vec::new(),
