@@ -130,15 +130,70 @@ fn err<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
 
+type CategoryChart<'a, DB> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// A bar chart with one category per case (`i..i + 1` on x, method names below) and `0..top` on y.
+fn category_chart<'a, DB: DrawingBackend>(
+    root: &'a Area<'_, DB>,
+    title: &str,
+    y_desc: &str,
+    cases: &[&CaseResult],
+    top: f64,
+) -> Result<CategoryChart<'a, DB>, String> {
+    let n = cases.len().max(1);
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(70)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..n as f64, 0.0..top)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(0)
+        .y_desc(y_desc)
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    label_categories(root, &chart, cases)?;
+    Ok(chart)
+}
+
+/// Colour swatches with labels in the upper left of a category chart (`n` categories, y up to
+/// `top`).
+fn swatch_legend<DB: DrawingBackend>(
+    chart: &mut CategoryChart<'_, DB>,
+    n: usize,
+    top: f64,
+    entries: &[(&str, ShapeStyle)],
+) -> DrawResult {
+    let n = n as f64;
+    for (k, (label, style)) in entries.iter().enumerate() {
+        let y = top * (0.95 - 0.06 * k as f64);
+        chart
+            .draw_series(std::iter::once(Rectangle::new([(0.05 * n, y), (0.08 * n, y - 0.03 * top)], *style)))
+            .map_err(err)?;
+        chart
+            .draw_series(std::iter::once(Text::new(
+                label.to_string(),
+                (0.09 * n, y + 0.005 * top),
+                ("sans-serif", 14),
+            )))
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
 /// The method names under the bars of a category chart (category `i` spans `i..i + 1` on x),
 /// drawn on `root` below the x axis.
 fn label_categories<DB: DrawingBackend>(
     root: &Area<'_, DB>,
-    chart: &ChartContext<
-        '_,
-        DB,
-        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
-    >,
+    chart: &CategoryChart<'_, DB>,
     cases: &[&CaseResult],
 ) -> DrawResult {
     let style = TextStyle::from(("sans-serif", 13).into_font()).pos(plotters::style::text_anchor::Pos::new(
@@ -159,22 +214,8 @@ fn draw_errors<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &[
         cases.iter().filter(|c| c.e_theta_deg.is_finite() && c.e_phi_deg.is_finite()).collect();
     let top = ok.iter().map(|c| c.e_theta_deg.max(c.e_phi_deg)).fold(0.0, f64::max).max(1e-3) * 1.15;
     let n = cases.len().max(1);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{scenario}: angle errors (degrees; lower is better)"), ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(70)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..n as f64, 0.0..top)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .disable_x_mesh()
-        .x_labels(0)
-        .y_desc("degrees")
-        .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(err)?;
-    label_categories(&root, &chart, cases)?;
+    let title = format!("{scenario}: angle errors (degrees; lower is better)");
+    let mut chart = category_chart(&root, &title, "degrees", cases, top)?;
     for (i, c) in cases.iter().enumerate() {
         let color = method_color(&c.method);
         let x = i as f64;
@@ -197,28 +238,13 @@ fn draw_errors<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &[
                 .map_err(err)?;
         }
     }
-    // Legend for the two bar kinds.
     let grey = RGBColor(90, 90, 90);
-    for (k, label, style) in
-        [(0, "E_θ (corner angles)", grey.filled()), (1, "E_φ (dihedral angles)", grey.mix(0.45).filled())]
-    {
-        chart
-            .draw_series(std::iter::once(Rectangle::new(
-                [
-                    (0.05 * n as f64, top * (0.95 - 0.06 * k as f64)),
-                    (0.08 * n as f64, top * (0.92 - 0.06 * k as f64)),
-                ],
-                style,
-            )))
-            .map_err(err)?;
-        chart
-            .draw_series(std::iter::once(Text::new(
-                label,
-                (0.09 * n as f64, top * (0.955 - 0.06 * k as f64)),
-                ("sans-serif", 14),
-            )))
-            .map_err(err)?;
-    }
+    swatch_legend(
+        &mut chart,
+        n,
+        top,
+        &[("E_θ (corner angles)", grey.filled()), ("E_φ (dihedral angles)", grey.mix(0.45).filled())],
+    )?;
     Ok(())
 }
 
@@ -231,22 +257,8 @@ fn draw_timings<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &
     };
     let top = cases.iter().map(|c| parts(c).iter().sum::<f64>()).fold(0.0, f64::max).max(1e-3) * 1.12;
     let n = cases.len().max(1);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(format!("{scenario}: time per phase (seconds)"), ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(70)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..n as f64, 0.0..top)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .disable_x_mesh()
-        .x_labels(0)
-        .y_desc("seconds")
-        .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(err)?;
-    label_categories(&root, &chart, cases)?;
+    let title = format!("{scenario}: time per phase (seconds)");
+    let mut chart = category_chart(&root, &title, "seconds", cases, top)?;
     let phase_colors = [RGBColor(120, 120, 200), RGBColor(230, 160, 60), RGBColor(90, 170, 90)];
     for (i, c) in cases.iter().enumerate() {
         let mut bottom = 0.0;
@@ -268,26 +280,10 @@ fn draw_timings<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &
             )))
             .map_err(err)?;
     }
-    for (k, (label, color)) in
-        ["precompute", "handle bind", "solve (iterations)"].iter().zip(phase_colors).enumerate()
-    {
-        chart
-            .draw_series(std::iter::once(Rectangle::new(
-                [
-                    (0.05 * n as f64, top * (0.95 - 0.06 * k as f64)),
-                    (0.08 * n as f64, top * (0.92 - 0.06 * k as f64)),
-                ],
-                color.filled(),
-            )))
-            .map_err(err)?;
-        chart
-            .draw_series(std::iter::once(Text::new(
-                *label,
-                (0.09 * n as f64, top * (0.955 - 0.06 * k as f64)),
-                ("sans-serif", 14),
-            )))
-            .map_err(err)?;
-    }
+    let labels = ["precompute", "handle bind", "solve (iterations)"];
+    let entries: Vec<(&str, ShapeStyle)> =
+        labels.iter().zip(phase_colors).map(|(l, c)| (*l, c.filled())).collect();
+    swatch_legend(&mut chart, n, top, &entries)?;
     Ok(())
 }
 
