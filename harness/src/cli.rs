@@ -70,8 +70,8 @@ enum Command {
 
 #[derive(Args, Clone)]
 struct Peers {
-    /// Check every result for self-intersections with open3d (slow on large meshes: ~25 s per
-    /// result on the bumpy plane) and report it in the `self_intersecting` column.
+    /// Check every result of up to 100K faces for self-intersections with open3d (slow on large
+    /// meshes: ~25 s per result on the bumpy plane) and report it in the `self_intersecting` column.
     #[arg(long)]
     self_intersections: bool,
     /// The cross-check Python with open3d (`scripts/python-env` prints it).
