@@ -413,23 +413,41 @@ fn draw_scaling<DB: DrawingBackend>(root: Area<'_, DB>, sweeps: &[&CaseResult]) 
         .map_err(err)?;
     for m in methods {
         let color = method_color(m);
-        let points = line(m);
-        chart
-            .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
-            .map_err(err)?
-            .label(m.to_string())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
-        chart.draw_series(points.into_iter().map(|p| Circle::new(p, 4, color.filled()))).map_err(err)?;
+        labelled_line(&mut chart, line(m), color, color.stroke_width(2), m.to_string())?;
     }
+    draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)
+}
+
+/// A polyline with a dot on every point, labelled for the legend.
+fn labelled_line<'a, DB: DrawingBackend + 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    points: Vec<(f64, f64)>,
+    color: RGBColor,
+    style: ShapeStyle,
+    label: String,
+) -> DrawResult {
+    chart
+        .draw_series(LineSeries::new(points.clone(), style))
+        .map_err(err)?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
+    chart.draw_series(points.into_iter().map(|p| Circle::new(p, 4, color.filled()))).map_err(err)?;
+    Ok(())
+}
+
+/// The series legend at `position`.
+fn draw_legend<'a, DB: DrawingBackend + 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    position: SeriesLabelPosition,
+) -> DrawResult {
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
+        .position(position)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 14))
         .draw()
-        .map_err(err)?;
-    Ok(())
+        .map_err(err)
 }
 
 /// Handle-set update time against the number of handles: `hirm`'s `t_h` and the `isolines`
@@ -478,20 +496,7 @@ fn draw_table1<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult]) ->
         let label = format!("{} ({})", c.method, c.scenario);
         let points = series(c);
         let style = color.stroke_width(if dashed { 1 } else { 3 });
-        chart
-            .draw_series(LineSeries::new(points.clone(), style))
-            .map_err(err)?
-            .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
-        chart.draw_series(points.into_iter().map(|p| Circle::new(p, 4, color.filled()))).map_err(err)?;
+        labelled_line(&mut chart, points, color, style, label)?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(err)?;
-    Ok(())
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
 }

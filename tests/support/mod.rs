@@ -44,14 +44,7 @@ pub fn python() -> Option<PathBuf> {
 
 /// Run `tests/crosscheck/igl_reference.py` with `args`; panics with its stderr on failure. Returns stdout.
 pub fn igl_reference(python: &Path, args: &[&str]) -> String {
-    let script = workspace_root().join("tests/crosscheck/igl_reference.py");
-    let out = Command::new(python).arg(&script).args(args).output().expect("run python");
-    assert!(
-        out.status.success(),
-        "igl_reference.py {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).expect("utf-8")
+    run_script(python, "igl_reference.py", args)
 }
 
 /// Whitespace-separated numbers per non-empty line.
@@ -76,12 +69,14 @@ pub fn survey_case(dir: &Path, name: &str) -> (meshes::TriMesh, methods::HandleS
 /// Run `tests/crosscheck/peers_reference.py` (pymeshlab/open3d references) with `args`; panics with its
 /// stderr on failure. Returns stdout.
 pub fn peers_reference(python: &Path, args: &[&str]) -> String {
-    let script = workspace_root().join("tests/crosscheck/peers_reference.py");
-    let out = Command::new(python).arg(&script).args(args).output().expect("run python");
-    assert!(
-        out.status.success(),
-        "peers_reference.py {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    run_script(python, "peers_reference.py", args)
+}
+
+/// Run the cross-check script `tests/crosscheck/<script>` with `args`; panics with its stderr on
+/// failure. Returns stdout.
+fn run_script(python: &Path, script: &str, args: &[&str]) -> String {
+    let path = workspace_root().join("tests/crosscheck").join(script);
+    let out = Command::new(python).arg(&path).args(args).output().expect("run python");
+    assert!(out.status.success(), "{script} {args:?} failed:\n{}", String::from_utf8_lossy(&out.stderr));
     String::from_utf8(out.stdout).expect("utf-8")
 }
