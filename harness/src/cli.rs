@@ -266,7 +266,11 @@ fn execute(
             if foreign.is_empty() {
                 Ok((path, regression::check(&baseline, &run.results)))
             } else {
-                Err(format!("the run used other data than the baseline for {}", foreign.join(", ")))
+                Err(format!(
+                    "the run used other data than the baseline for {} case(s), e.g. {}",
+                    foreign.len(),
+                    foreign[0]
+                ))
             }
         }
         Ok(path) => Err(format!("no baseline at {} (write one with `harness baseline`)", path.display())),
