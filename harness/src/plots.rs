@@ -13,6 +13,7 @@
 
 use std::path::{Path, PathBuf};
 
+use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -322,53 +323,45 @@ fn draw_convergence<DB: DrawingBackend>(
         let mut builder = ChartBuilder::on(panel);
         builder.margin(8).x_label_area_size(36).y_label_area_size(56);
         if log {
-            let mut chart = builder
-                .build_cartesian_2d((1.0..max_iter).log_scale(), (lo.max(1e-16) * 0.8..hi * 1.25).log_scale())
-                .map_err(err)?;
-            chart
-                .configure_mesh()
-                .x_desc("iteration + 1")
-                .y_desc(label)
-                .label_style(("sans-serif", 12))
-                .draw()
-                .map_err(err)?;
-            for c in cases {
-                let color = method_color(&c.method);
-                chart
-                    .draw_series(LineSeries::new(points(c), color.stroke_width(2)))
-                    .map_err(err)?
-                    .label(c.method.clone())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
-            }
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::LowerLeft)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 12))
-                .draw()
-                .map_err(err)?;
+            let y = (lo.max(1e-16) * 0.8..hi * 1.25).log_scale();
+            let mut chart = builder.build_cartesian_2d((1.0..max_iter).log_scale(), y).map_err(err)?;
+            convergence_lines(&mut chart, cases, &points, label)?;
+            draw_legend(&mut chart, SeriesLabelPosition::LowerLeft, 12)?;
         } else {
             let span = (hi - lo).max(1e-9);
-            let mut chart = builder
-                .build_cartesian_2d(
-                    (1.0..max_iter).log_scale(),
-                    (lo - 0.05 * span).max(0.0)..hi + 0.05 * span,
-                )
-                .map_err(err)?;
-            chart
-                .configure_mesh()
-                .x_desc("iteration + 1")
-                .y_desc(label)
-                .label_style(("sans-serif", 12))
-                .draw()
-                .map_err(err)?;
-            for c in cases {
-                chart
-                    .draw_series(LineSeries::new(points(c), method_color(&c.method).stroke_width(2)))
-                    .map_err(err)?;
-            }
+            let y = (lo - 0.05 * span).max(0.0)..hi + 0.05 * span;
+            let mut chart = builder.build_cartesian_2d((1.0..max_iter).log_scale(), y).map_err(err)?;
+            convergence_lines(&mut chart, cases, &points, label)?;
         }
+    }
+    Ok(())
+}
+
+/// The axes (labelled `label` on y) and one labelled line per case of a convergence panel.
+fn convergence_lines<'a, DB: DrawingBackend + 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    cases: &[&CaseResult],
+    points: &dyn Fn(&CaseResult) -> Vec<(f64, f64)>,
+    label: &str,
+) -> DrawResult
+where
+    X: ValueFormatter<f64>,
+    Y: ValueFormatter<f64>,
+{
+    chart
+        .configure_mesh()
+        .x_desc("iteration + 1")
+        .y_desc(label)
+        .label_style(("sans-serif", 12))
+        .draw()
+        .map_err(err)?;
+    for c in cases {
+        let style = method_color(&c.method).stroke_width(2);
+        chart
+            .draw_series(LineSeries::new(points(c), style))
+            .map_err(err)?
+            .label(c.method.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
     }
     Ok(())
 }
@@ -415,7 +408,7 @@ fn draw_scaling<DB: DrawingBackend>(root: Area<'_, DB>, sweeps: &[&CaseResult]) 
         let color = method_color(m);
         labelled_line(&mut chart, line(m), color, color.stroke_width(2), m.to_string())?;
     }
-    draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)
+    draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, 14)
 }
 
 /// A polyline with a dot on every point, labelled for the legend.
@@ -435,17 +428,18 @@ fn labelled_line<'a, DB: DrawingBackend + 'a, X: Ranged<ValueType = f64>, Y: Ran
     Ok(())
 }
 
-/// The series legend at `position`.
+/// The series legend at `position`, in `font_size` pixels.
 fn draw_legend<'a, DB: DrawingBackend + 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
     position: SeriesLabelPosition,
+    font_size: u32,
 ) -> DrawResult {
     chart
         .configure_series_labels()
         .position(position)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .label_font(("sans-serif", 14))
+        .label_font(("sans-serif", font_size))
         .draw()
         .map_err(err)
 }
@@ -498,5 +492,5 @@ fn draw_table1<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult]) ->
         let style = color.stroke_width(if dashed { 1 } else { 3 });
         labelled_line(&mut chart, points, color, style, label)?;
     }
-    draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 14)
 }

@@ -69,14 +69,7 @@ impl AffineTransform {
 
     /// Rotation by `angle` radians about the unit `axis` through `center`.
     pub fn rotation_about(axis: [f64; 3], angle: f64, center: [f64; 3]) -> Self {
-        let [x, y, z] = crate::vector::normalize_or_zero(axis);
-        let (s, c) = angle.sin_cos();
-        let t = 1.0 - c;
-        let r = [
-            [t * x * x + c, t * x * y - s * z, t * x * z + s * y],
-            [t * x * y + s * z, t * y * y + c, t * y * z - s * x],
-            [t * x * z - s * y, t * y * z + s * x, t * z * z + c],
-        ];
+        let r = crate::vector::rotation_matrix(crate::vector::normalize_or_zero(axis), angle);
         let mut rows = [[0.0; 4]; 4];
         for i in 0..3 {
             rows[i][..3].copy_from_slice(&r[i]);

@@ -46,3 +46,17 @@ pub fn normalize_or_zero(a: [f64; 3]) -> [f64; 3] {
 pub fn angle_between(a: [f64; 3], b: [f64; 3]) -> f64 {
     norm(cross(a, b)).atan2(dot(a, b))
 }
+
+/// Rotation matrix (row major) by `angle` radians about the unit `axis` (Rodrigues:
+/// `cos I + sin [axis]x + (1 - cos) axis axis^T`).
+#[inline]
+pub fn rotation_matrix(axis: [f64; 3], angle: f64) -> [[f64; 3]; 3] {
+    let [x, y, z] = axis;
+    let (s, c) = angle.sin_cos();
+    let t = 1.0 - c;
+    [
+        [t * x * x + c, t * x * y - s * z, t * x * z + s * y],
+        [t * x * y + s * z, t * y * y + c, t * y * z - s * x],
+        [t * x * z - s * y, t * y * z + s * x, t * z * z + c],
+    ]
+}

@@ -23,8 +23,9 @@
 //! Decisions the paper leaves open (tested in `methods/tests/scale_aware.rs`):
 //! - Iterations reported to the observer: iteration 0 is the initialization, 1.. are the outer
 //!   iterations of Algorithm 1; `scale_aware_ora` reports the stitching as one more iteration.
-//!   Convergence is Algorithm 1's: the largest vertex step of an outer iteration below
-//!   `tolerance x bbox diagonal` (the stitching step does not count).
+//!   Convergence is Algorithm 1's: the fixed-point residual `|T(x) - x|` (the largest vertex move
+//!   of a plain outer iteration) below `tolerance x bbox diagonal`; the stitching step does not
+//!   count.
 //! - At least three constrained vertices are required (section 4, "at least three"); fewer leave
 //!   the similarity of `G` undetermined.
 //! - Every solve starts from the Laplacian initialization of the current shape, so a second edit
@@ -81,7 +82,8 @@ pub struct ScaleAwareParams {
     pub constraint_weight: f64,
     /// Limit on the outer iterations of Algorithm 1 per solve.
     pub max_iterations: usize,
-    /// Converged when an outer iteration moves no vertex by more than `tolerance x bbox diagonal`.
+    /// Converged when the plain outer iteration `T` would move no vertex by more than
+    /// `tolerance x bbox diagonal` (the fixed-point residual `|T(x) - x|`).
     pub tolerance: f64,
     /// Limit on the local/global iterations of step one per outer iteration (the paper: "usually
     /// 5–20").

@@ -7,6 +7,7 @@
 //! change when the normals do (the symbolic factorization is reused across outer iterations).
 
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use meshes::vector::rotation_matrix;
 
 use super::scale_invariant_measures::ScaleInvariantMeasures;
 use crate::rotation_fit::Mat3;
@@ -157,7 +158,7 @@ impl ScaleAwareEquations {
 /// The 3x3 coefficient blocks of eq 2 for one corner, on `v`, `v_i`, `v_{i+1}`:
 /// `l R - I`, `-l R`, `I`, with `R` the rotation by `theta` about the unit `normal`.
 fn corner_coefficients(normal: [f64; 3], theta: f64, l: f64) -> [Mat3; 3] {
-    let r = rotation_about(normal, theta);
+    let r = rotation_matrix(normal, theta);
     let mut at_v = [[0.0; 3]; 3];
     let mut at_vi = [[0.0; 3]; 3];
     for i in 0..3 {
@@ -167,19 +168,6 @@ fn corner_coefficients(normal: [f64; 3], theta: f64, l: f64) -> [Mat3; 3] {
         }
     }
     [at_v, at_vi, [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]]
-}
-
-/// Rotation by `theta` about the unit `axis` (Rodrigues): `cos I + sin [n]x + (1 - cos) n n^T`.
-pub(crate) fn rotation_about(axis: [f64; 3], theta: f64) -> Mat3 {
-    let (s, c) = theta.sin_cos();
-    let [x, y, z] = axis;
-    let cross = [[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]];
-    std::array::from_fn(|i| {
-        std::array::from_fn(|j| {
-            let id = if i == j { c } else { 0.0 };
-            id + s * cross[i][j] + (1.0 - c) * axis[i] * axis[j]
-        })
-    })
 }
 
 /// `acc += a^T b` for 3x3 matrices.
