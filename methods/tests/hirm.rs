@@ -200,3 +200,44 @@ fn bad_parameters_and_phases_are_errors() {
     let small = HandleSet::new(vec![HandleRegion { name: "h".into(), vertices: vec![0] }], 10).unwrap();
     assert!(hirm.bind_handles(&small).is_err(), "a handle set for another mesh size");
 }
+
+/// The handle update of eq 26, accumulated in place on the lower triangle, against its definition
+/// `T_1 + omega^2 sum_k (Phi W)_k^T (Phi W)_k` built row by row from the vertex weights; the
+/// full-matrix variant (used by `isolines`) is the same matrix, symmetric.
+#[test]
+fn handle_update_adds_the_constraint_term_to_t1() {
+    let (mesh, handles) = bar();
+    let mut hirm = Hirm::new(HirmParams::default()).unwrap();
+    hirm.precompute(&mesh).unwrap();
+    let built = handle_independent_model(mesh.positions(), &hirm.system_inputs().unwrap());
+    let (model, system) = (&built.model, &built.system);
+    let omega = 1000.0;
+    let size = 4 * model.n_isolines();
+    let mut expected = system.smoothness_normal_matrix.clone();
+    for v in handles.constrained() {
+        let x = mesh.positions()[v as usize];
+        let mut row = vec![0.0; size];
+        for &(m, w) in model.vertex_weights(v as usize) {
+            for (d, h) in [x[0], x[1], x[2], 1.0].into_iter().enumerate() {
+                row[4 * m as usize + d] += w * h;
+            }
+        }
+        for i in 0..size {
+            for j in 0..size {
+                expected[(i, j)] += omega * omega * row[i] * row[j];
+            }
+        }
+    }
+    let scale = expected.norm_max();
+    let mut lower = faer::Mat::<f64>::from_fn(size, size, |_, _| f64::NAN);
+    system.constrained_normal_matrix_lower_into(model, &handles, omega, lower.as_mut());
+    let full = system.constrained_normal_matrix(model, &handles, omega);
+    for j in 0..size {
+        for i in j..size {
+            assert!((lower[(i, j)] - expected[(i, j)]).abs() <= 1e-12 * scale, "lower ({i}, {j})");
+        }
+        for i in 0..size {
+            assert!((full[(i, j)] - expected[(i, j)]).abs() <= 1e-12 * scale, "full ({i}, {j})");
+        }
+    }
+}

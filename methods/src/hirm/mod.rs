@@ -32,8 +32,9 @@ pub mod propagation_fields;
 use std::sync::Arc;
 use std::time::Instant;
 
-use faer::linalg::solvers::Llt;
-use faer::{Mat, Side};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
+use faer::{Mat, Par};
 use meshes::{Topology, TriMesh};
 use serde::Deserialize;
 
@@ -106,7 +107,6 @@ enum Precomputed {
 /// Everything `bind_handles` adds for one handle set.
 struct Bound {
     independent: Arc<HandleIndependentModel>,
-    factor: Llt<f64>,
     handles: HandleSet,
 }
 
@@ -120,6 +120,11 @@ pub struct Hirm {
     current: Vec<[f64; 3]>,
     /// `4N x 3` reduced variables of the current solve.
     reduced: Mat<f64>,
+    /// `L` of `U^T U = L L^T` (eq 26) of the bound handle set, `4N x 4N` (lower triangle), factored
+    /// in place in storage kept between handle sets, with its factorization workspace: a handle
+    /// update allocates nothing once the size is known.
+    normal_factor: Mat<f64>,
+    factor_workspace: MemBuffer,
     timings: Vec<(&'static str, f64)>,
 }
 
@@ -150,6 +155,12 @@ impl Hirm {
             bound: None,
             current: Vec::new(),
             reduced: Mat::zeros(0, 3),
+            normal_factor: Mat::zeros(0, 0),
+            factor_workspace: MemBuffer::new(cholesky_in_place_scratch::<f64>(
+                0,
+                Par::Seq,
+                Default::default(),
+            )),
             timings: Vec::new(),
         })
     }
@@ -241,17 +252,33 @@ impl DeformationMethod for Hirm {
         let wait = Instant::now();
         let independent = self.handle_independent()?.expect("precompute leaves a model or a worker");
         self.set_timing("bind_background_wait", wait.elapsed().as_secs_f64());
-        // t_h: eq 26 and the factorization of U^T U.
+        // t_h: eq 26 and the factorization of U^T U. The factor's storage is overwritten, so the
+        // previous handle set is unbound first: a failed update leaves no stale binding.
+        self.bound = None;
         let start = Instant::now();
-        let normal =
-            independent.system.constrained_normal_matrix(&independent.model, handles, self.params.omega);
-        let factor = normal
-            .as_ref()
-            .llt(Side::Lower)
-            .map_err(|_| MethodError::Solver(crate::sparse_cholesky::SolverError::NotPositiveDefinite))?;
+        let size = 4 * independent.model.n_isolines();
+        if self.normal_factor.nrows() != size {
+            self.normal_factor = Mat::zeros(size, size);
+            self.factor_workspace =
+                MemBuffer::new(cholesky_in_place_scratch::<f64>(size, Par::Seq, Default::default()));
+        }
+        independent.system.constrained_normal_matrix_lower_into(
+            &independent.model,
+            handles,
+            self.params.omega,
+            self.normal_factor.as_mut(),
+        );
+        cholesky_in_place(
+            self.normal_factor.as_mut(),
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut self.factor_workspace),
+            Default::default(),
+        )
+        .map_err(|_| MethodError::Solver(crate::sparse_cholesky::SolverError::NotPositiveDefinite))?;
         self.set_timing("t_h_handle_update", start.elapsed().as_secs_f64());
         self.reduced = independent.model.identity_transforms();
-        self.bound = Some(Bound { independent, factor, handles: handles.clone() });
+        self.bound = Some(Bound { independent, handles: handles.clone() });
         Ok(())
     }
 
@@ -278,7 +305,13 @@ impl DeformationMethod for Hirm {
             rhs += &constraints;
             let stop;
             (summary, stop) = finish_reduced_iteration(
-                ReducedIteration { method: "hirm", iteration, start, model, factor: &bound.factor },
+                ReducedIteration {
+                    method: "hirm",
+                    iteration,
+                    start,
+                    model,
+                    factor: self.normal_factor.as_ref(),
+                },
                 rhs,
                 &mut self.reduced,
                 &mut probes,

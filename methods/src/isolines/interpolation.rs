@@ -11,8 +11,9 @@
 //! (`W_x^T L^T L W_x + beta^2 M^T M`, `W_x^T L^T W_delta`); [`ReducedSystem`] adds a handle set's
 //! constraint term to give `U^T U` (`4N x 4N`) and the constraint right-hand side.
 
+use faer::reborrow::ReborrowMut;
 use faer::sparse::SparseColMatRef;
-use faer::{Mat, MatRef};
+use faer::{Mat, MatMut, MatRef};
 
 use meshes::vector::{cross, dot, normalize_or_zero, scale, sub};
 
@@ -502,69 +503,76 @@ impl HandleIndependentSystem {
     }
 
     /// `U^T U = T_1 + omega^2 (Phi W_x)^T (Phi W_x)` (eq 6; HIRM eq 26) for the constrained vertices
-    /// of `handles`, `4N x 4N`.
+    /// of `handles`, `4N x 4N`, both triangles.
     pub fn constrained_normal_matrix(
         &self,
         model: &IsolineModel,
         handles: &HandleSet,
         omega: f64,
     ) -> Mat<f64> {
-        // Row k of Phi W_x is w_k (x) (x_k, 1): per isoline m of vertex k, 4 contiguous columns.
-        // Accumulate in a dense block over the isolines the handles touch (a few hundred
-        // columns, in cache) with 4-wide updates, then add the block to T_1 once.
-        let w2 = omega * omega;
-        let mut local_of = vec![usize::MAX; model.n_isolines()];
-        let mut touched: Vec<usize> = Vec::new();
-        for v in handles.constrained() {
-            for &(m, _) in model.vertex_weights(v as usize) {
-                if local_of[m as usize] == usize::MAX {
-                    local_of[m as usize] = touched.len();
-                    touched.push(m as usize);
-                }
-            }
-        }
-        let c = 4 * touched.len();
-        let mut block = vec![0.0f64; c * c]; // column major
-        let mut local: Vec<(usize, f64)> = Vec::new();
-        for v in handles.constrained() {
-            let x = model.base[v as usize];
-            let h = [x[0], x[1], x[2], 1.0];
-            local.clear();
-            local
-                .extend(model.vertex_weights(v as usize).iter().map(|&(m, w)| (4 * local_of[m as usize], w)));
-            for &(lq, wq) in &local {
-                for (d, hd) in h.iter().enumerate() {
-                    let column = &mut block[(lq + d) * c..(lq + d + 1) * c];
-                    let s = w2 * wq * hd;
-                    for &(lp, wp) in &local {
-                        let f = s * wp;
-                        // A fixed-size chunk: one bounds check and a 4-wide update.
-                        let cell: &mut [f64; 4] =
-                            (&mut column[lp..lp + 4]).try_into().expect("4 columns per isoline");
-                        for (o, he) in cell.iter_mut().zip(&h) {
-                            *o += f * he;
-                        }
-                    }
-                }
-            }
-        }
         let mut normal_matrix = self.smoothness_normal_matrix.clone();
-        for (lq, &mq) in touched.iter().enumerate() {
-            for d in 0..4 {
-                let column = normal_matrix
-                    .col_mut(4 * mq + d)
-                    .try_as_col_major_mut()
-                    .expect("owned matrix")
-                    .as_slice_mut();
-                let local = &block[(4 * lq + d) * c..(4 * lq + d + 1) * c];
-                for (lp, &mp) in touched.iter().enumerate() {
-                    for e in 0..4 {
-                        column[4 * mp + e] += local[4 * lp + e];
-                    }
-                }
+        add_constraint_term_lower(model, handles, omega, normal_matrix.as_mut());
+        let n = normal_matrix.nrows();
+        for j in 0..n {
+            for i in 0..j {
+                normal_matrix[(i, j)] = normal_matrix[(j, i)];
             }
         }
         normal_matrix
+    }
+
+    /// The lower triangle of [`HandleIndependentSystem::constrained_normal_matrix`] into `out`
+    /// (`4N x 4N`, overwritten; its strict upper triangle is left unspecified), for an in-place
+    /// Cholesky factorization: HIRM's handle update (eq 26) without allocation.
+    pub fn constrained_normal_matrix_lower_into(
+        &self,
+        model: &IsolineModel,
+        handles: &HandleSet,
+        omega: f64,
+        mut out: MatMut<'_, f64>,
+    ) {
+        out.copy_from_triangular_lower(self.smoothness_normal_matrix.as_ref());
+        add_constraint_term_lower(model, handles, omega, out);
+    }
+}
+
+/// `out += omega^2 (Phi W_x)^T (Phi W_x)` on the lower triangle of the `4N x 4N` `out` (the
+/// `4 x 4` blocks on the diagonal are updated whole).
+///
+/// Row `k` of `Phi W_x` is `w_k (x) (x_k, 1)`: per isoline `m` of vertex `k`, 4 contiguous
+/// columns. Only the blocks of isoline pairs `(p, q)` with `p >= q` are accumulated, 4 wide.
+fn add_constraint_term_lower(
+    model: &IsolineModel,
+    handles: &HandleSet,
+    omega: f64,
+    mut out: MatMut<'_, f64>,
+) {
+    let w2 = omega * omega;
+    for v in handles.constrained() {
+        let x = model.base[v as usize];
+        let h = [x[0], x[1], x[2], 1.0];
+        let local = model.vertex_weights(v as usize);
+        for &(mq, wq) in local {
+            let q = 4 * mq as usize;
+            for (d, hd) in h.iter().enumerate() {
+                let column = out.rb_mut().col_mut(q + d).try_as_col_major_mut().expect("column-major output");
+                let column = column.as_slice_mut();
+                let s = w2 * wq * hd;
+                for &(mp, wp) in local {
+                    if mp < mq {
+                        continue;
+                    }
+                    let f = s * wp;
+                    let p = 4 * mp as usize;
+                    // A fixed-size chunk: one bounds check and a 4-wide update.
+                    let cell: &mut [f64; 4] =
+                        (&mut column[p..p + 4]).try_into().expect("4 columns per isoline");
+                    for (o, he) in cell.iter_mut().zip(&h) {
+                        *o += f * he;
+                    }
+                }
+            }
+        }
     }
 }
 

@@ -45,7 +45,7 @@ pub mod tracing;
 
 use std::time::Instant;
 
-use faer::linalg::solvers::{Llt, SolveCore};
+use faer::linalg::solvers::Llt;
 use faer::{Mat, MatRef, Side};
 use meshes::vector::{cross, dot, normalize_or_zero, scale, sub};
 use meshes::{Topology, TriMesh};
@@ -299,7 +299,7 @@ impl DeformationMethod for Isolines {
                     iteration,
                     start,
                     model: &bound.model,
-                    factor: &bound.factor,
+                    factor: bound.factor.L(),
                 },
                 rhs,
                 &mut self.reduced,
@@ -345,8 +345,8 @@ pub(crate) struct ReducedIteration<'a> {
     /// When the iteration's own work started.
     pub start: Instant,
     pub model: &'a IsolineModel,
-    /// `LL^T` of `U^T U`.
-    pub factor: &'a Llt<f64>,
+    /// `L` of `U^T U = L L^T` (lower triangle; the strict upper one is not read).
+    pub factor: MatRef<'a, f64>,
 }
 
 /// The end of one iteration of an isoline reduced model (Au et al. 2007 eq 10, HIRM eq 20): solve
@@ -363,7 +363,13 @@ pub(crate) fn finish_reduced_iteration(
     tolerance: f64,
     observer: &mut dyn IterationObserver,
 ) -> Result<(SolveSummary, bool), MethodError> {
-    it.factor.solve_in_place_with_conj(faer::Conj::No, rhs.as_mut());
+    faer::linalg::cholesky::llt::solve::solve_in_place_with_conj(
+        it.factor,
+        faer::Conj::No,
+        rhs.as_mut(),
+        faer::Par::Seq,
+        faer::dyn_stack::MemStack::new(&mut []),
+    );
     *reduced = rhs;
     let next = it.model.probe_positions(reduced.as_ref());
     if let Some(i) = next.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
