@@ -61,6 +61,8 @@ pub fn smallest_eigenpairs(
 
     let cap = basis + b;
     let mut v = Mat::<f64>::zeros(n, cap);
+    // Restarts write the kept Ritz vectors here (allocated at the first restart).
+    let mut spare = Mat::<f64>::zeros(0, 0);
     let mut h = Mat::<f64>::zeros(cap, cap);
     let mut w = Mat::<f64>::zeros(n, b);
     let mut rng = SplitMix64::new(options.seed);
@@ -169,21 +171,20 @@ pub fn smallest_eigenpairs(
         // Keep about half of the unwanted part too; a multiple of `b` short of `basis`, so the next
         // cycle ends exactly at `basis` columns again.
         let keep = basis - b * ((basis - (k + (s - k) / 2)) / b).max(1);
-        let mut ritz = Mat::<f64>::zeros(n, keep);
+        // The new basis is built in the spare buffer, which then becomes the basis.
+        if spare.nrows() != n {
+            spare = Mat::zeros(n, cap);
+        }
         matmul(
-            ritz.as_mut(),
+            spare.as_mut().subcols_mut(0, keep),
             Accum::Replace,
             v.as_ref().subcols(0, s),
             y.as_ref().subcols(0, keep),
             1.0,
             par,
         );
-        v.as_mut().subcols_mut(0, keep).copy_from(ritz.as_ref());
-        for j in 0..b {
-            for i in 0..n {
-                v[(i, keep + j)] = v[(i, s + j)];
-            }
-        }
+        spare.as_mut().subcols_mut(keep, b).copy_from(v.as_ref().subcols(s, b));
+        std::mem::swap(&mut v, &mut spare);
         h.fill(0.0);
         for t in 0..keep {
             h[(t, t)] = theta[t];
