@@ -122,6 +122,23 @@ fn lagrange_with_more_constraints_than_bases_is_a_clear_error() {
     assert!(e.contains("at most m = 20") && e.contains("penalty"), "{e}");
 }
 
+/// An eigensolver that does not converge is reported as such (not as a parameter error), with
+/// the counts it reached.
+#[test]
+fn eigensolver_failure_is_an_eigensolver_error() {
+    let (mesh, _, _) = bar(1500);
+    let mut method = SpectralMhb::new(params("bases = 10\neigen_tolerance = 1e-300")).unwrap();
+    let e = method.precompute(&mesh).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            methods::MethodError::Eigen(methods::spectral::EigenError::NotConverged { wanted: 9, .. })
+        ),
+        "{e:?}"
+    );
+    assert!(e.to_string().starts_with("eigensolver: did not converge"), "{e}");
+}
+
 #[test]
 fn paper_phases_are_reported() {
     let (mesh, handles, handle) = bar(1500);

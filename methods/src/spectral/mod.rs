@@ -82,7 +82,7 @@ pub enum EigenError {
     TooMany { count: usize, n: usize },
     #[error("invalid input: {0}")]
     Invalid(String),
-    #[error("eigensolver did not converge: {converged} of {wanted} eigenpairs after {restarts} restarts")]
+    #[error("did not converge: {converged} of {wanted} eigenpairs after {restarts} restarts")]
     NotConverged { converged: usize, wanted: usize, restarts: usize },
     #[error("shift-invert factorization: {0}")]
     Solver(SolverError),

@@ -218,9 +218,8 @@ impl DeformationMethod for SpectralMhb {
         let mut options = EigenOptions::new(m);
         options.tolerance = self.params.eigen_tolerance;
         options.seed = self.params.seed;
-        let pairs = smallest_eigenpairs(stiffness.as_ref(), &mhb_mass, &options).map_err(|e| {
-            MethodError::Parameters { method: "spectral_mhb", message: format!("manifold harmonics: {e}") }
-        })?;
+        let pairs =
+            smallest_eigenpairs(stiffness.as_ref(), &mhb_mass, &options).map_err(MethodError::Eigen)?;
         self.basis = pairs.vectors;
         self.set_timing("pt1_manifold_harmonics", start.elapsed().as_secs_f64());
 
