@@ -69,7 +69,34 @@ fn cotan_laplacian_and_mass_match_libigl() {
 fn arap_matches_libigl_arap_solve() {
     let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
     for name in ["cylinder", "bar", "cactus"] {
-        let (mesh, handles, targets) = survey_case(&dir, name);
+        let case = ArapCase::new(&dir, name);
+        for iterations in [10usize, 100] {
+            let theirs = case.libigl_arap(&py, iterations);
+            let ours = case.our_arap(iterations);
+            let rms = harness::metrics::rms_distance(&ours, &theirs, case.mesh.bbox_diagonal());
+            println!("{name}: {iterations} iterations, RMS distance to libigl / bbox diagonal = {rms:.2e}");
+            assert!(
+                rms <= 1e-3,
+                "{name}: arap after {iterations} iterations is {rms:e} x diagonal from libigl's"
+            );
+        }
+    }
+}
+
+/// A survey edit for the ARAP comparisons, with its constraints written in the `index x y z` format of
+/// igl_reference.py `arap` and peers_reference.py `open3d_arap`, in a scratch directory.
+struct ArapCase {
+    mesh: meshes::TriMesh,
+    handles: methods::HandleSet,
+    targets: methods::HandleTargets,
+    work: tempfile::TempDir,
+    constraints: std::path::PathBuf,
+    mesh_path: std::path::PathBuf,
+}
+
+impl ArapCase {
+    fn new(dir: &std::path::Path, name: &str) -> Self {
+        let (mesh, handles, targets) = survey_case(dir, name);
         let work = tempfile::tempdir().unwrap();
         let constraints = work.path().join("constraints.txt");
         let lines: String = handles
@@ -79,34 +106,34 @@ fn arap_matches_libigl_arap_solve() {
             .collect();
         std::fs::write(&constraints, lines).unwrap();
         let mesh_path = dir.join(format!("{name}.off"));
-        for iterations in [10usize, 100] {
-            let out = work.path().join(format!("arap{iterations}.txt"));
-            igl_reference(
-                &py,
-                &[
-                    "arap",
-                    mesh_path.to_str().unwrap(),
-                    constraints.to_str().unwrap(),
-                    &iterations.to_string(),
-                    out.to_str().unwrap(),
-                ],
-            );
-            let theirs: Vec<[f64; 3]> = read_rows(&out).into_iter().map(|r| [r[0], r[1], r[2]]).collect();
-            let params: toml::Table =
-                format!("max_iterations = {iterations}\ntolerance = 0.0").parse().unwrap();
-            let mut arap = methods::registry::create("arap", &params).unwrap();
-            arap.precompute(&mesh).unwrap();
-            arap.bind_handles(&handles).unwrap();
-            let summary = arap.solve(&targets, &mut NoObserver).unwrap();
-            assert_eq!(summary.iterations, iterations);
-            let ours = arap.positions();
-            let rms = harness::metrics::rms_distance(&ours, &theirs, mesh.bbox_diagonal());
-            println!("{name}: {iterations} iterations, RMS distance to libigl / bbox diagonal = {rms:.2e}");
-            assert!(
-                rms <= 1e-3,
-                "{name}: arap after {iterations} iterations is {rms:e} x diagonal from libigl's"
-            );
-        }
+        Self { mesh, handles, targets, work, constraints, mesh_path }
+    }
+
+    /// libigl's `arap_solve` after `iterations` iterations (igl_reference.py `arap`), `#V x 3`.
+    fn libigl_arap(&self, python: &std::path::Path, iterations: usize) -> Vec<[f64; 3]> {
+        let out = self.work.path().join(format!("igl{iterations}.txt"));
+        igl_reference(
+            python,
+            &[
+                "arap",
+                self.mesh_path.to_str().unwrap(),
+                self.constraints.to_str().unwrap(),
+                &iterations.to_string(),
+                out.to_str().unwrap(),
+            ],
+        );
+        read_rows(&out).into_iter().map(|r| [r[0], r[1], r[2]]).collect()
+    }
+
+    /// Our `arap` after exactly `iterations` iterations (no early exit), from the rest shape.
+    fn our_arap(&self, iterations: usize) -> Vec<[f64; 3]> {
+        let params: toml::Table = format!("max_iterations = {iterations}\ntolerance = 0.0").parse().unwrap();
+        let mut arap = methods::registry::create("arap", &params).unwrap();
+        arap.precompute(&self.mesh).unwrap();
+        arap.bind_handles(&self.handles).unwrap();
+        let summary = arap.solve(&self.targets, &mut NoObserver).unwrap();
+        assert_eq!(summary.iterations, iterations);
+        arap.positions()
     }
 }
 
@@ -190,33 +217,6 @@ fn manifold_harmonics_match_scipy_eigsh() {
 
 use support::peers_reference;
 
-/// Writes the `index x y z` constraints file (igl_reference.py `arap` / peers_reference.py
-/// `open3d_arap` format) of a survey edit.
-fn write_constraints(path: &std::path::Path, handles: &methods::HandleSet, targets: &methods::HandleTargets) {
-    let lines: String = handles
-        .constrained()
-        .zip(targets.positions())
-        .map(|(v, t)| format!("{v} {:e} {:e} {:e}\n", t[0], t[1], t[2]))
-        .collect();
-    std::fs::write(path, lines).unwrap();
-}
-
-/// Our `arap` after exactly `iterations` iterations (no early exit), from the rest shape.
-fn our_arap(
-    mesh: &meshes::TriMesh,
-    handles: &methods::HandleSet,
-    targets: &methods::HandleTargets,
-    iterations: usize,
-) -> Vec<[f64; 3]> {
-    let params: toml::Table = format!("max_iterations = {iterations}\ntolerance = 0.0").parse().unwrap();
-    let mut arap = methods::registry::create("arap", &params).unwrap();
-    arap.precompute(mesh).unwrap();
-    arap.bind_handles(handles).unwrap();
-    let summary = arap.solve(targets, &mut NoObserver).unwrap();
-    assert_eq!(summary.iterations, iterations);
-    arap.positions()
-}
-
 /// Largest vertex distance between two `#V x 3` arrays.
 fn max_vertex_distance(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     assert_eq!(a.len(), b.len());
@@ -296,28 +296,14 @@ const ARAP_CASES: [(&str, &[usize]); 4] =
 fn peers_arap_hausdorff_distance_to_libigl_arap_is_small() {
     let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
     for (name, iteration_counts) in ARAP_CASES {
-        let (mesh, handles, targets) = survey_case(&dir, name);
+        let case = ArapCase::new(&dir, name);
+        let (mesh, work) = (&case.mesh, case.work.path());
         let diagonal = mesh.bbox_diagonal();
-        let work = tempfile::tempdir().unwrap();
-        let constraints = work.path().join("constraints.txt");
-        write_constraints(&constraints, &handles, &targets);
-        let mesh_path = dir.join(format!("{name}.off"));
         for &iterations in iteration_counts {
-            let igl_out = work.path().join(format!("igl{iterations}.txt"));
-            igl_reference(
-                &py,
-                &[
-                    "arap",
-                    mesh_path.to_str().unwrap(),
-                    constraints.to_str().unwrap(),
-                    &iterations.to_string(),
-                    igl_out.to_str().unwrap(),
-                ],
-            );
-            let theirs: Vec<[f64; 3]> = read_rows(&igl_out).into_iter().map(|r| [r[0], r[1], r[2]]).collect();
-            let ours = our_arap(&mesh, &handles, &targets, iterations);
-            let ours_off = work.path().join(format!("ours{iterations}.off"));
-            let theirs_off = work.path().join(format!("igl{iterations}.off"));
+            let theirs = case.libigl_arap(&py, iterations);
+            let ours = case.our_arap(iterations);
+            let ours_off = work.join(format!("ours{iterations}.off"));
+            let theirs_off = work.join(format!("igl{iterations}.off"));
             meshes::io::write_off(&ours_off, &mesh.with_positions(ours.clone()).unwrap()).unwrap();
             meshes::io::write_off(&theirs_off, &mesh.with_positions(theirs.clone()).unwrap()).unwrap();
             let report: serde_json::Value = serde_json::from_str(&peers_reference(
@@ -375,20 +361,17 @@ fn peers_arap_hausdorff_distance_to_libigl_arap_is_small() {
 fn peers_arap_agrees_with_open3d_arap() {
     let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
     for (name, iteration_counts) in ARAP_CASES {
-        let (mesh, handles, targets) = survey_case(&dir, name);
+        let case = ArapCase::new(&dir, name);
+        let (mesh, handles, targets) = (&case.mesh, &case.handles, &case.targets);
         let diagonal = mesh.bbox_diagonal();
-        let work = tempfile::tempdir().unwrap();
-        let constraints = work.path().join("constraints.txt");
-        write_constraints(&constraints, &handles, &targets);
-        let mesh_path = dir.join(format!("{name}.off"));
         for &iterations in iteration_counts {
-            let out = work.path().join(format!("open3d{iterations}.off"));
+            let out = case.work.path().join(format!("open3d{iterations}.off"));
             peers_reference(
                 &py,
                 &[
                     "open3d_arap",
-                    mesh_path.to_str().unwrap(),
-                    constraints.to_str().unwrap(),
+                    case.mesh_path.to_str().unwrap(),
+                    case.constraints.to_str().unwrap(),
                     out.to_str().unwrap(),
                     "--iterations",
                     &iterations.to_string(),
@@ -397,11 +380,11 @@ fn peers_arap_agrees_with_open3d_arap() {
             let theirs = meshes::io::read_mesh(&out).unwrap();
             assert_eq!(theirs.triangles(), mesh.triangles());
             let theirs = theirs.positions();
-            let ours = our_arap(&mesh, &handles, &targets, iterations);
+            let ours = case.our_arap(iterations);
             let rms = harness::metrics::rms_distance(&ours, theirs, diagonal);
             let max = max_vertex_distance(&ours, theirs) / diagonal;
             let moved = harness::metrics::rms_distance(&ours, mesh.positions(), diagonal);
-            let residual = harness::metrics::handle_residual(&handles, &targets, theirs, diagonal);
+            let residual = harness::metrics::handle_residual(handles, targets, theirs, diagonal);
             println!(
                 "{name}: {iterations} iterations, open3d vs ours / bbox diagonal: RMS {rms:.2e}, max {max:.2e}; RMS / our RMS displacement {:.3}; open3d handle residual {residual:.1e}",
                 rms / moved
