@@ -63,7 +63,6 @@ on bar after 20 iterations of its 135-degree twist; 7e-6 on cactus). Compare wit
 that order, not 1e-12.
 """
 
-import argparse
 import json
 import os
 import sys
@@ -79,17 +78,16 @@ import scipy.sparse.linalg as spla  # noqa: E402
 
 import igl  # noqa: E402
 
-
-class UsageError(Exception):
-    pass
-
-
-class ArgumentParser(argparse.ArgumentParser):
-    """argparse exits with code 2 on bad usage; this CLI uses 1 for every error."""
-
-    def error(self, message):
-        self.print_usage(sys.stderr)
-        self.exit(1, f"{self.prog}: error: {message}\n")
+from reference_cli import (  # noqa: E402
+    ArgumentParser,
+    UsageError,
+    check_file,
+    check_indices,
+    positive_int,
+    read_rows,
+    read_vector_constraints,
+    write_matrix,
+)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -97,8 +95,7 @@ class ArgumentParser(argparse.ArgumentParser):
 
 
 def read_mesh(path):
-    if not os.path.isfile(path):
-        raise UsageError(f"mesh file not found: {path}")
+    check_file(path, "mesh")
     V, F = igl.read_triangle_mesh(path)
     V = np.ascontiguousarray(V, dtype=np.float64)
     F = np.ascontiguousarray(F, dtype=np.int64)
@@ -107,34 +104,6 @@ def read_mesh(path):
     if F.ndim != 2 or F.shape[0] == 0 or F.shape[1] != 3:
         raise UsageError(f"could not read triangles from {path} (got shape {F.shape})")
     return V, F
-
-
-def read_rows(path, ncols, what):
-    """Reads whitespace-separated rows of `ncols` numbers, skipping blanks and '#' comments."""
-    if not os.path.isfile(path):
-        raise UsageError(f"{what} file not found: {path}")
-    rows = []
-    with open(path) as fh:
-        for lineno, line in enumerate(fh, 1):
-            s = line.strip()
-            if not s or s.startswith("#"):
-                continue
-            parts = s.split()
-            if len(parts) != ncols:
-                raise UsageError(f"{path}:{lineno}: expected {ncols} fields, got {len(parts)}")
-            rows.append(parts)
-    if not rows:
-        raise UsageError(f"{path}: no {what} rows")
-    return rows
-
-
-def read_vector_constraints(path, n):
-    """`index x y z` lines -> (b int64 array, bc float64 (#b, 3) array)."""
-    rows = read_rows(path, 4, "constraints")
-    b = np.array([int(r[0]) for r in rows], dtype=np.int64)
-    bc = np.array([[float(x) for x in r[1:]] for r in rows], dtype=np.float64)
-    check_indices(b, n, path)
-    return b, bc
 
 
 def read_scalar_constraints(path, n):
@@ -146,32 +115,8 @@ def read_scalar_constraints(path, n):
     return b, bc
 
 
-def check_indices(b, n, path):
-    if b.min() < 0 or b.max() >= n:
-        raise UsageError(f"{path}: vertex index out of range [0, {n})")
-    if len(np.unique(b)) != len(b):
-        raise UsageError(f"{path}: duplicate vertex indices")
-
-
-def write_matrix(path, A):
-    A = np.asarray(A, dtype=np.float64)
-    if A.ndim == 1:
-        A = A[:, None]
-    np.savetxt(path, A, fmt="%.17g", delimiter=" ")
-
-
 def ensure_dir(path):
     os.makedirs(path, exist_ok=True)
-
-
-def positive_int(s):
-    try:
-        v = int(s)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not an integer: {s!r}")
-    if v <= 0:
-        raise argparse.ArgumentTypeError(f"must be positive: {s!r}")
-    return v
 
 
 # ---------------------------------------------------------------------------------------------

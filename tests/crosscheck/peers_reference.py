@@ -65,12 +65,20 @@ self_intersecting MESH [MESH ...]
 Errors go to stderr naming the file, with exit code 1. Nothing else is printed on stdout.
 """
 
-import argparse
 import json
 import os
 import sys
 
 import numpy as np
+
+from reference_cli import (
+    ArgumentParser,
+    UsageError,
+    check_file,
+    positive_int,
+    read_vector_constraints,
+    write_matrix,
+)
 
 # pymeshlab and open3d are imported by the subcommands that use them (`import open3d` alone takes
 # about 1.8 s, most of it its plotly/dash visualizer stack).
@@ -94,25 +102,8 @@ def import_open3d():
     o3d = module
 
 
-class UsageError(Exception):
-    pass
-
-
-class ArgumentParser(argparse.ArgumentParser):
-    """argparse exits with code 2 on bad usage; this CLI uses 1 for every error."""
-
-    def error(self, message):
-        self.print_usage(sys.stderr)
-        self.exit(1, f"{self.prog}: error: {message}\n")
-
-
 # ---------------------------------------------------------------------------------------------
 # I/O helpers
-
-
-def check_file(path, what):
-    if not os.path.isfile(path):
-        raise UsageError(f"{what} file not found: {path}")
 
 
 def read_off(path):
@@ -152,49 +143,6 @@ def write_off(path, V, F):
             fh.write("%.17g %.17g %.17g\n" % (x, y, z))
         for i, j, k in F.tolist():
             fh.write("3 %d %d %d\n" % (i, j, k))
-
-
-def read_vector_constraints(path, n):
-    """`index x y z` lines -> (indices list, (#b, 3) float64 array); same format as igl_reference.py."""
-    check_file(path, "constraints")
-    idx, pos = [], []
-    with open(path) as fh:
-        for lineno, line in enumerate(fh, 1):
-            s = line.strip()
-            if not s or s.startswith("#"):
-                continue
-            parts = s.split()
-            if len(parts) != 4:
-                raise UsageError(f"{path}:{lineno}: expected 4 fields `index x y z`, got {len(parts)}")
-            try:
-                idx.append(int(parts[0]))
-                pos.append([float(x) for x in parts[1:]])
-            except ValueError as e:
-                raise UsageError(f"{path}:{lineno}: {e}")
-    if not idx:
-        raise UsageError(f"{path}: no constraints rows")
-    if min(idx) < 0 or max(idx) >= n:
-        raise UsageError(f"{path}: vertex index out of range [0, {n})")
-    if len(set(idx)) != len(idx):
-        raise UsageError(f"{path}: duplicate vertex indices")
-    return idx, np.array(pos, dtype=np.float64)
-
-
-def write_matrix(path, A, fmt="%.17g"):
-    A = np.asarray(A)
-    if A.ndim == 1:
-        A = A[:, None]
-    np.savetxt(path, A, fmt=fmt, delimiter=" ")
-
-
-def positive_int(s):
-    try:
-        v = int(s)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not an integer: {s!r}")
-    if v <= 0:
-        raise argparse.ArgumentTypeError(f"must be positive: {s!r}")
-    return v
 
 
 def load_meshset(*paths):
@@ -315,7 +263,7 @@ def cmd_open3d_arap(args):
     idx, pos = read_vector_constraints(args.constraints, len(V))
     mesh = open3d_mesh(V, F)
     out = mesh.deform_as_rigid_as_possible(
-        o3d.utility.IntVector(idx),
+        o3d.utility.IntVector(idx.tolist()),
         o3d.utility.Vector3dVector(pos),
         max_iter=args.iterations,
         energy=o3d.geometry.DeformAsRigidAsPossibleEnergy.Spokes,
