@@ -25,9 +25,9 @@ const PARALLEL_MIN_COLS: usize = 16;
 
 /// faer picks the supernodal factorization when its flops per factor entry exceed 40 times this
 /// (its default is 1). Cotangent Laplacians of the survey meshes have ratios of 20–50 and factor
-/// 1.2–1.7x faster supernodally (numeric phase, measured: bar 9.5 ms simplicial against 5.5 ms
-/// supernodal, cylinder 4.0 against 3.0, cactus 4.8 against 4.1; `examples/cholesky_solve_timing`
-/// for the solves); chains and other thin patterns stay simplicial.
+/// 1.2–1.7x faster supernodally (numeric phase of `-L + 1e-6 M`, best of 10: bar 9.5 ms simplicial
+/// against 5.5 ms supernodal, cylinder 4.0 against 3.0, cactus 4.8 against 4.1); chains and other
+/// thin patterns stay simplicial.
 const SUPERNODAL_THRESHOLD: SupernodalThreshold = SupernodalThreshold(0.25);
 
 /// Failures of the sparse solver layer.
