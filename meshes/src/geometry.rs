@@ -102,3 +102,61 @@ pub fn vertex_normals_into(positions: &[[f64; 3]], triangles: &[[u32; 3]], out: 
     }
     out.iter_mut().for_each(|n| *n = normalize_or_zero(*n));
 }
+
+/// `#E` lengths of the edges `edges` (pairs of vertex indices into `positions`).
+pub fn edge_lengths(positions: &[[f64; 3]], edges: &[[u32; 2]]) -> Vec<f64> {
+    edges.iter().map(|[a, b]| norm(sub(positions[*b as usize], positions[*a as usize]))).collect()
+}
+
+/// Signed volume enclosed by the `#F x 3` `triangles` of `#V x 3` `positions`:
+/// `1/6 sum_f (a - c) . ((b - c) x (d - c))` over faces `f = (a, b, d)` with `c` the centroid of the
+/// vertices, positive when the faces are oriented outwards (right-hand rule). Meaningful for a closed
+/// surface only; subtracting the centroid keeps it exact for meshes far from the origin.
+pub fn signed_volume(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> f64 {
+    if positions.is_empty() {
+        return 0.0;
+    }
+    let n = positions.len() as f64;
+    let c: [f64; 3] = std::array::from_fn(|k| positions.iter().map(|p| p[k]).sum::<f64>() / n);
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, d] = t.map(|i| sub(positions[i as usize], c));
+            crate::vector::dot(a, cross(b, d))
+        })
+        .sum::<f64>()
+        / 6.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The unit tetrahedron (outward faces), moved far from the origin.
+    fn tetrahedron(offset: f64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let p = p.iter().map(|v| v.map(|c| c + offset)).collect();
+        (p, vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    }
+
+    #[test]
+    fn signed_volume_of_a_tetrahedron_far_from_the_origin() {
+        for offset in [0.0, 1e6] {
+            let (p, t) = tetrahedron(offset);
+            let v = signed_volume(&p, &t);
+            assert!((v - 1.0 / 6.0).abs() < 1e-12, "offset {offset}: {v}");
+            let flipped: Vec<[u32; 3]> = t.iter().map(|f| [f[0], f[2], f[1]]).collect();
+            assert!((signed_volume(&p, &flipped) + 1.0 / 6.0).abs() < 1e-12, "inward faces: negative");
+        }
+        assert_eq!(signed_volume(&[], &[]), 0.0);
+    }
+
+    #[test]
+    fn edge_lengths_in_edge_order() {
+        let (p, _) = tetrahedron(0.0);
+        let l = edge_lengths(&p, &[[0, 1], [1, 2], [3, 0]]);
+        assert_eq!(l[0], 1.0);
+        assert!((l[1] - 2f64.sqrt()).abs() < 1e-15);
+        assert_eq!(l[2], 1.0);
+    }
+}
