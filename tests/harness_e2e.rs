@@ -48,7 +48,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
                 .iter()
                 .find(|r| r["scenario"] == scenario && r["method"] == method)
                 .unwrap_or_else(|| panic!("no row for {scenario} / {method}"));
-            assert_eq!(row["status"], "ok", "{scenario}/{method}");
+            assert!(!row["status"].starts_with("failed"), "{scenario}/{method}: {}", row["status"]);
             assert_eq!(row["mesh_source"], "survey");
             let residual = num(row, "handle_residual_over_diag");
             // The issue's bounds for the references; the reduced models only approximate their handles.
@@ -61,10 +61,14 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
             for key in [
                 "e_theta_deg",
                 "e_phi_deg",
+                "e_area",
+                "e_length",
+                "folds",
                 "precompute_s",
                 "bind_s",
                 "median_iteration_ms",
                 "rms_to_arap_over_diag",
+                "max_to_arap_over_diag",
             ] {
                 let v = num(row, key);
                 assert!(v.is_finite() && v >= 0.0, "{scenario}/{method}: {key} = {v}");
@@ -77,7 +81,27 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
         }
         let arap = rows.iter().find(|r| r["scenario"] == scenario && r["method"] == "arap").unwrap();
         assert_eq!(num(arap, "rms_to_arap_over_diag"), 0.0);
+        // The isoline model reaches its hard handles, does not fold and stays in its frame.
+        let isolines = rows.iter().find(|r| r["scenario"] == scenario && r["method"] == "isolines").unwrap();
+        assert_eq!(isolines["status"], "ok", "{scenario}/isolines");
     }
+    // Issue 14: what the angles hide. The survey bar is open (no volume); the scale-aware balloon on it
+    // shows in e_area, many times arap's.
+    let case = |scenario: &str, method: &str| {
+        rows.iter().find(|r| r["scenario"] == scenario && r["method"] == method).unwrap()
+    };
+    assert!(case("bar", "arap")["volume_change"].is_empty(), "the survey bar is open");
+    let (balloon, arap) = (num(case("bar", "scale_aware"), "e_area"), num(case("bar", "arap"), "e_area"));
+    assert!(balloon > 0.4 && balloon > 5.0 * arap, "bar e_area: scale_aware {balloon}, arap {arap}");
+    // The closed cylinder: the linear-ish methods and scale_aware shrink it, arap far less.
+    let arap_volume = num(case("cylinder", "arap"), "volume_change");
+    for method in ["laplacian", "isolines", "scale_aware"] {
+        let (area, volume) = (num(case("cylinder", method), "e_area"), num(case("cylinder", method), "volume_change"));
+        assert!(area > 0.3 && volume < -0.2 && volume < 2.0 * arap_volume, "cylinder/{method}: e_area {area}, volume {volume}");
+    }
+    // HIRM with 10 close handles on the cactus tears and folds: a verdict, not `ok`.
+    let torn = &case("cactus-handles", "hirm")["status"];
+    assert!(torn.starts_with("suspect: ") && torn.contains("folds"), "cactus-handles/hirm: {torn}");
     // Au et al. 2007, Fig. 9: on the bar twist, fewer isolines show more of the linear effect (kinks
     // between isolines). 20 isolines must bend no worse than 10 (E_phi) and stay no farther from the
     // nonlinear reference (RMS to arap). E_theta is not part of the claim: measured, 20 isolines are
@@ -128,7 +152,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
     for scenario in ["bar-incremental", "cactus-incremental"] {
         for method in methods::registry::method_names() {
             let row = rows.iter().find(|r| r["scenario"] == scenario && r["method"] == method).unwrap();
-            assert_eq!(row["status"], "ok", "{scenario}/{method}");
+            assert!(!row["status"].starts_with("failed"), "{scenario}/{method}: {}", row["status"]);
             let steps: Vec<_> =
                 updates.iter().filter(|u| u["scenario"] == scenario && u["method"] == method).collect();
             let handles: Vec<&str> = steps.iter().map(|u| u["handles"].as_str()).collect();
@@ -176,11 +200,9 @@ fn without_survey_data_the_procedural_look_alikes_run_and_are_labelled() {
     let configs = tempfile::tempdir().unwrap();
     // Small look-alikes keep the test quick; the shapes are the same generators `all` uses.
     std::fs::create_dir(configs.path().join("scenarios")).unwrap();
-    std::fs::copy(
-        support::workspace_root().join("configs/methods.toml"),
-        configs.path().join("methods.toml"),
-    )
-    .unwrap();
+    for file in ["methods.toml", "verdicts.toml"] {
+        std::fs::copy(support::workspace_root().join("configs").join(file), configs.path().join(file)).unwrap();
+    }
     for shape in ["bar", "cylinder", "cactus", "plane"] {
         std::fs::write(
             configs.path().join(format!("scenarios/{shape}.toml")),
@@ -209,7 +231,7 @@ fn without_survey_data_the_procedural_look_alikes_run_and_are_labelled() {
     assert_eq!(rows.len(), 4 * methods::registry::METHODS.len());
     for row in &rows {
         assert_eq!(row["mesh_source"], "procedural look-alike");
-        assert_eq!(row["status"], "ok", "{}/{}", row["scenario"], row["method"]);
+        assert!(!row["status"].starts_with("failed"), "{}/{}: {}", row["scenario"], row["method"], row["status"]);
         if python.is_some() {
             let answer = row["self_intersecting"].as_str();
             assert!(
@@ -232,7 +254,7 @@ fn without_survey_data_the_procedural_look_alikes_run_and_are_labelled() {
             }
         }
     }
-    for figure in ["grid", "grid_heat", "bar-rest", "bar-arap", "bar-arap-heat"] {
+    for figure in ["grid", "grid_heat", "grid_area", "bar-rest", "bar-arap", "bar-arap-heat", "bar-arap-area"] {
         assert!(
             reports.path().join(format!("figures/{figure}.png")).is_file(),
             "missing figures/{figure}.png"
@@ -326,6 +348,8 @@ impl BadInputFixture {
         meshes::io::write_selection(data.join("tiny.sel"), &shape.selection).unwrap();
         meshes::io::write_transform(data.join("tiny.def"), &shape.transform).unwrap();
         std::fs::write(configs.join("methods.toml"), "[arap]\nmax_iterations = 3\n").unwrap();
+        std::fs::copy(support::workspace_root().join("configs/verdicts.toml"), configs.join("verdicts.toml"))
+            .unwrap();
         std::fs::write(configs.join("scenarios/tiny.toml"), "name = \"tiny\"\nsurvey = \"tiny\"\n").unwrap();
         std::fs::write(reports.join("sentinel.txt"), "untouched").unwrap();
         Self { _root: root, data, configs, reports }
@@ -494,6 +518,16 @@ fn unknown_method_parameter_is_rejected() {
     let f = BadInputFixture::new();
     std::fs::write(f.configs.join("methods.toml"), "[arap]\nmax_iter = 3\n").unwrap();
     f.expect_error(&["methods.toml", "max_iter"]);
+}
+
+#[test]
+fn missing_or_bad_verdict_rules_are_rejected() {
+    let f = BadInputFixture::new();
+    std::fs::write(f.configs.join("verdicts.toml"), "max_folds = 0\nmax_handle_residual_over_diag = 1e-3\n")
+        .unwrap();
+    f.expect_error(&["verdicts.toml", "frame_margin_diagonals"]);
+    std::fs::remove_file(f.configs.join("verdicts.toml")).unwrap();
+    f.expect_error(&["verdicts.toml"]);
 }
 
 #[test]

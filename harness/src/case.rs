@@ -6,8 +6,9 @@ use std::time::Instant;
 use methods::{IterationObserver, IterationReport};
 use serde::{Deserialize, Serialize};
 
-use crate::metrics::{angle_errors, handle_residual, RestAngles};
+use crate::metrics::{angle_errors, largest_displacement, Evaluation, Metric, Quality, RestGeometry};
 use crate::scenario::LoadedScenario;
+use crate::verdict::{Status, VerdictRules};
 
 /// One iteration as recorded for convergence curves.
 #[derive(Clone, Copy, Debug, Serialize, Deserialize)]
@@ -54,7 +55,7 @@ pub struct StepRecord {
 }
 
 /// Measurements of one case. Times are wall-clock seconds; the `*_over_diag` values are relative to
-/// the rest bounding-box diagonal; angle errors are in degrees.
+/// the rest bounding-box diagonal; the quality measures are those of [`crate::metrics::METRICS`].
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CaseResult {
     pub scenario: String,
@@ -74,20 +75,21 @@ pub struct CaseResult {
     #[serde(deserialize_with = "nan_from_null")]
     pub total_s: f64,
     pub converged: bool,
-    #[serde(deserialize_with = "nan_from_null")]
-    pub e_theta_deg: f64,
-    #[serde(deserialize_with = "nan_from_null")]
-    pub e_phi_deg: f64,
-    #[serde(deserialize_with = "nan_from_null")]
-    pub handle_residual_over_diag: f64,
-    /// Filled in once the scenario's `arap` result is known.
-    pub rms_to_arap_over_diag: Option<f64>,
+    /// Every measure of the metric table, one JSON field per metric key (`null`: none).
+    #[serde(flatten)]
+    pub quality: Quality,
+    /// Largest distance of a result vertex from its rest position.
+    #[serde(default, deserialize_with = "nan_from_null")]
+    pub largest_move_over_diag: f64,
+    /// Largest distance of a handle target from its vertex's rest position, over every step.
+    #[serde(default, deserialize_with = "nan_from_null")]
+    pub largest_handle_move_over_diag: f64,
     /// open3d's `is_self_intersecting` of the result, when the run asked for it
     /// (`--self-intersections`).
     #[serde(default)]
     pub self_intersecting: Option<bool>,
-    /// `ok`, or `failed: <reason>`.
-    pub status: String,
+    /// `ok`, `suspect: <reasons>` or `failed: <error>` ([`crate::verdict`]).
+    pub status: Status,
     /// Method-specific phases (e.g. HIRM's t_e, t_b) in seconds, after the last step.
     pub phase_timings: Vec<(String, f64)>,
     /// Sizes of a reduced model (e.g. HIRM's `n_field`), after the last step.
@@ -104,7 +106,7 @@ pub struct CaseResult {
 /// Records every iteration, with the angle errors of the iterate where [`records_quality`] says so.
 struct Recorder<'a> {
     scenario: &'a LoadedScenario,
-    rest_angles: &'a RestAngles,
+    rest: &'a RestGeometry,
     trace: Vec<IterationRecord>,
     /// 1-based edit step being solved.
     edit_step: usize,
@@ -125,7 +127,7 @@ impl IterationObserver for Recorder<'_> {
         if records_quality(r.iteration) {
             let t = Instant::now();
             let (e_theta, e_phi) =
-                angle_errors(self.rest_angles, &self.scenario.mesh, &self.scenario.topology, &shape());
+                angle_errors(self.rest, &self.scenario.mesh, &self.scenario.topology, &shape());
             record.e_theta_deg = Some(e_theta);
             record.e_phi_deg = Some(e_phi);
             self.quality_s += t.elapsed().as_secs_f64();
@@ -135,49 +137,50 @@ impl IterationObserver for Recorder<'_> {
     }
 }
 
-/// Run `method` (with its parameter table) on `scenario`. A method error becomes a `failed` result;
-/// it does not abort the run.
+/// The result the distances to the reference method (`arap`) are measured against.
+#[derive(Clone, Copy, Debug)]
+pub enum Reference<'a> {
+    /// This case is the reference (its distances are 0).
+    Itself,
+    /// The reference's `#V x 3` result on the same scenario.
+    Of(&'a [[f64; 3]]),
+    /// No reference result (not run, or failed).
+    Missing,
+}
+
+/// Run `method` (with its parameter table) on `scenario`, measure the result against `rest` (the
+/// scenario's rest geometry) and `reference`, and judge it by `rules`. A method error becomes a
+/// `failed` result; it does not abort the run.
 pub fn run_case(
     scenario: &LoadedScenario,
-    rest_angles: &RestAngles,
+    rest: &RestGeometry,
     method: &str,
     params: &toml::Table,
+    rules: &VerdictRules,
+    reference: Reference<'_>,
 ) -> CaseResult {
-    let mut result = CaseResult {
-        scenario: scenario.spec.name.clone(),
-        method: method.to_string(),
-        mesh_source: scenario.mesh_source.clone(),
-        vertices: scenario.mesh.n_vertices(),
-        faces: scenario.mesh.n_faces(),
-        precompute_s: f64::NAN,
-        bind_s: f64::NAN,
-        median_iteration_ms: f64::NAN,
-        iterations: 0,
-        solve_s: f64::NAN,
-        total_s: f64::NAN,
-        converged: false,
-        e_theta_deg: f64::NAN,
-        e_phi_deg: f64::NAN,
-        handle_residual_over_diag: f64::NAN,
-        rms_to_arap_over_diag: None,
-        self_intersecting: None,
-        status: String::new(),
-        phase_timings: Vec::new(),
-        statistics: Vec::new(),
-        steps: Vec::new(),
-        trace: Vec::new(),
-        positions: None,
-    };
-    let mut recorder = Recorder { scenario, rest_angles, trace: Vec::new(), edit_step: 0, quality_s: 0.0 };
-    let outcome = (|| -> Result<(), methods::MethodError> {
+    let mut result = CaseResult::empty(
+        &scenario.spec.name,
+        method,
+        &scenario.mesh_source,
+        scenario.mesh.n_vertices(),
+        scenario.mesh.n_faces(),
+    );
+    let mut recorder = Recorder { scenario, rest, trace: Vec::new(), edit_step: 0, quality_s: 0.0 };
+    let outcome = (|| -> Result<Vec<String>, methods::MethodError> {
         let mut m = methods::registry::create(method, params)?;
         let start = Instant::now();
         m.precompute(&scenario.mesh)?;
         result.precompute_s = start.elapsed().as_secs_f64();
         let mut solve_s = 0.0;
         let mut final_edit = None;
+        let mut largest_handle_move = 0.0f64;
         for (i, step) in scenario.steps.iter().enumerate() {
             let targets = step.targets(&m.positions())?;
+            for (v, t) in step.handles.constrained().zip(targets.positions()) {
+                let d = meshes::vector::norm(meshes::vector::sub(*t, scenario.mesh.positions()[v as usize]));
+                largest_handle_move = largest_handle_move.max(d);
+            }
             let t = Instant::now();
             m.bind_handles(&step.handles)?;
             let bind_s = t.elapsed().as_secs_f64();
@@ -217,19 +220,36 @@ pub fn run_case(
                 iteration: result.iterations,
             });
         }
-        let diagonal = scenario.mesh.bbox_diagonal();
-        let (e_theta, e_phi) = angle_errors(rest_angles, &scenario.mesh, &scenario.topology, &positions);
-        result.e_theta_deg = e_theta;
-        result.e_phi_deg = e_phi;
-        result.handle_residual_over_diag = handle_residual(&step.handles, &targets, &positions, diagonal);
+        let reference = match reference {
+            Reference::Itself => Some(&positions[..]),
+            Reference::Of(r) => Some(r),
+            Reference::Missing => None,
+        };
+        result.quality = Quality::evaluate(&Evaluation {
+            rest,
+            mesh: &scenario.mesh,
+            topology: &scenario.topology,
+            result: &positions,
+            handles: &step.handles,
+            targets: &targets,
+            reference,
+        });
+        result.largest_move_over_diag =
+            largest_displacement(scenario.mesh.positions(), &positions) / rest.diagonal;
+        result.largest_handle_move_over_diag = largest_handle_move / rest.diagonal;
+        let reasons = rules.reasons(
+            &result.quality,
+            result.largest_move_over_diag,
+            result.largest_handle_move_over_diag,
+        );
         result.positions = Some(positions);
-        Ok(())
+        Ok(reasons)
     })();
     result.median_iteration_ms = median_ms(&recorder.trace);
     result.trace = recorder.trace;
     result.status = match outcome {
-        Ok(()) => "ok".into(),
-        Err(e) => format!("failed: {e}"),
+        Ok(reasons) => Status::from_reasons(reasons),
+        Err(e) => Status::Failed(e.to_string()),
     };
     result
 }
@@ -237,6 +257,41 @@ pub fn run_case(
 /// `results.json` writes a missing (NaN) number as `null`; read it back as NaN.
 fn nan_from_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+impl CaseResult {
+    /// A case that has not run yet: no timings (NaN), no measures, status `ok`, no steps or positions.
+    pub fn empty(scenario: &str, method: &str, mesh_source: &str, vertices: usize, faces: usize) -> Self {
+        CaseResult {
+            scenario: scenario.to_string(),
+            method: method.to_string(),
+            mesh_source: mesh_source.to_string(),
+            vertices,
+            faces,
+            precompute_s: f64::NAN,
+            bind_s: f64::NAN,
+            median_iteration_ms: f64::NAN,
+            iterations: 0,
+            solve_s: f64::NAN,
+            total_s: f64::NAN,
+            converged: false,
+            quality: Quality::default(),
+            largest_move_over_diag: f64::NAN,
+            largest_handle_move_over_diag: f64::NAN,
+            self_intersecting: None,
+            status: Status::Ok,
+            phase_timings: Vec::new(),
+            statistics: Vec::new(),
+            steps: Vec::new(),
+            trace: Vec::new(),
+            positions: None,
+        }
+    }
+
+    /// The value of `metric`, NaN where there is none.
+    pub fn metric(&self, metric: Metric) -> f64 {
+        self.quality.value(metric)
+    }
 }
 
 /// Median iteration time in milliseconds (NaN for none).

@@ -5,6 +5,9 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use crate::case::CaseResult;
+use crate::metrics::METRICS;
+use crate::regression::{BaselineKind, GateOutcome};
 use crate::scenario::load_specs;
 use crate::suite::{self, SuiteOptions, SURVEY_DIR_ENV};
 use crate::{html, peers, plots, regression, render, report};
@@ -99,14 +102,18 @@ impl Peers {
 
 #[derive(Args, Clone)]
 struct Gate {
-    /// The regression baseline [default: reports/baseline.json in the workspace].
+    /// The regression baseline [default: reports/baselines/survey.json in the workspace for a run on
+    /// the survey data, reports/baselines/procedural.json for one on the procedural look-alikes].
     #[arg(long)]
     baseline: Option<PathBuf>,
 }
 
 impl Gate {
-    fn path(&self) -> PathBuf {
-        self.baseline.clone().unwrap_or_else(|| suite::workspace_root().join("reports/baseline.json"))
+    /// The baseline `results` are compared with.
+    fn path(&self, results: &[CaseResult]) -> PathBuf {
+        self.baseline
+            .clone()
+            .unwrap_or_else(|| BaselineKind::of(results).default_path(&suite::workspace_root()))
     }
 }
 
@@ -168,7 +175,7 @@ where
             } else if !same(&options.configs_dir, &default_configs) {
                 Err(format!("the baseline covers the scenarios of {}", default_configs.display()))
             } else {
-                Ok(gate.path())
+                Ok(gate)
             };
             execute(&options, peers.python()?, gate)
         }
@@ -180,28 +187,26 @@ where
         Command::Check { common, gate } => {
             let dir = common.options(Vec::new(), Vec::new()).reports_dir;
             let (results, _) = regression::read_results(&dir.join("results.json"))?;
-            let baseline = regression::read_baseline(&gate.path())?;
-            let foreign = regression::foreign_cases(&baseline, &results);
-            if !foreign.is_empty() {
-                anyhow::bail!(
-                    "{}: these cases ran on other data than the baseline's: {}",
-                    gate.path().display(),
-                    foreign.join(", ")
-                );
+            let path = gate.path(&results);
+            if !path.is_file() {
+                anyhow::bail!("{}: no such baseline", path.display());
             }
-            let findings = regression::check(&baseline, &results);
-            Ok(print_findings(&findings, &gate.path()))
+            match regression::gate(&path, &results)? {
+                GateOutcome::Checked { baseline, findings } => Ok(print_findings(&findings, &baseline)),
+                GateOutcome::NotChecked(reason) => anyhow::bail!("{reason}"),
+            }
         }
         Command::Baseline { common, gate } => {
             let dir = common.options(Vec::new(), Vec::new()).reports_dir;
             let (results, _) = regression::read_results(&dir.join("results.json"))?;
             let baseline = regression::baseline_from(&results);
-            regression::write_baseline(&gate.path(), &baseline)?;
+            let path = gate.path(&results);
+            regression::write_baseline(&path, &baseline)?;
             println!(
                 "baseline: {} cases from {} written to {}",
                 baseline.cases.len(),
                 dir.display(),
-                gate.path().display()
+                path.display()
             );
             Ok(ExitCode::SUCCESS)
         }
@@ -240,11 +245,11 @@ fn print_findings(findings: &[regression::Finding], baseline: &std::path::Path) 
 }
 
 /// Run the suite, check the results with open3d when `peer_python` is given, write every report,
-/// and compare with the baseline at `gate` (or say why not).
+/// and compare with the baseline `gate` names (or say why not).
 fn execute(
     options: &SuiteOptions,
     peer_python: Option<PathBuf>,
-    gate: Result<PathBuf, String>,
+    gate: Result<Gate, String>,
 ) -> anyhow::Result<ExitCode> {
     let mut run = suite::run(options).context("preparing the run")?;
     if let Some(python) = peer_python {
@@ -259,81 +264,59 @@ fn execute(
     let mut images = plots::write_plots(dir, &run.results).context("writing plots")?;
     images.extend(render::write_figures(dir, &run.results, &run.scenarios).context("writing figures")?);
 
-    let findings = match gate {
-        Ok(path) if path.is_file() => {
-            let baseline = regression::read_baseline(&path)?;
-            let foreign = regression::foreign_cases(&baseline, &run.results);
-            if foreign.is_empty() {
-                Ok((path, regression::check(&baseline, &run.results)))
-            } else {
-                Err(format!(
-                    "the run used other data than the baseline for {} case(s), e.g. {}",
-                    foreign.len(),
-                    foreign[0]
-                ))
-            }
-        }
-        Ok(path) => Err(format!("no baseline at {} (write one with `harness baseline`)", path.display())),
-        Err(reason) => Err(reason),
-    };
-    let verdict = match &findings {
-        Ok((_, f)) => html::Verdict::Checked {
-            findings: f.iter().map(|f| f.to_string()).collect(),
-            regressions: f.iter().filter(|f| f.is_regression()).count(),
-        },
-        Err(reason) => html::Verdict::NotChecked(reason.clone()),
+    let outcome = match gate {
+        Ok(gate) => regression::gate(&gate.path(&run.results), &run.results)?,
+        Err(reason) => GateOutcome::NotChecked(reason),
     };
     let table1 = report::render_table1(&run.results);
-    html::write_index(dir, &html::render_index(&run.results, &run.data_source, &images, &table1, &verdict))
+    html::write_index(dir, &html::render_index(&run.results, &run.data_source, &images, &table1, &outcome))
         .context("writing index.html")?;
 
     println!("data: {}", run.data_source);
-    println!(
-        "{:<12} {:<12} {:>7} {:>10} {:>9} {:>10} {:>6} {:>9} {:>9} {:>10} {:>10}  status",
-        "scenario",
-        "method",
-        "#V",
-        "precomp s",
-        "bind s",
-        "iter ms",
-        "iters",
-        "E_th deg",
-        "E_ph deg",
-        "resid/diag",
-        "arap/diag"
-    );
-    let mut failed = 0;
-    for r in &run.results {
-        println!(
-            "{:<12} {:<12} {:>7} {:>10.4} {:>9.4} {:>10.3} {:>6} {:>9.4} {:>9.4} {:>10.2e} {:>10}  {}",
-            r.scenario,
-            r.method,
-            r.vertices,
-            r.precompute_s,
-            r.bind_s,
-            r.median_iteration_ms,
-            r.iterations,
-            r.e_theta_deg,
-            r.e_phi_deg,
-            r.handle_residual_over_diag,
-            r.rms_to_arap_over_diag.map(|v| format!("{v:.2e}")).unwrap_or_else(|| "-".into()),
-            r.status
-        );
-        if r.status != "ok" {
-            failed += 1;
-        }
-    }
+    print_table(&run.results);
     println!("reports: {} (open index.html)", options.reports_dir.display());
-    let gate_code = match &findings {
-        Ok((path, f)) => print_findings(f, path),
-        Err(reason) => {
+    let gate_code = match &outcome {
+        GateOutcome::Checked { baseline, findings } => print_findings(findings, baseline),
+        GateOutcome::NotChecked(reason) => {
             println!("regression check skipped: {reason}");
             ExitCode::SUCCESS
         }
     };
+    let suspect = run.results.iter().filter(|r| r.status.is_suspect()).count();
+    if suspect > 0 {
+        println!("{suspect} case(s) suspect (see the status column and the reasons there)");
+    }
+    let failed = run.results.iter().filter(|r| r.status.is_failed()).count();
     if failed > 0 {
         eprintln!("error: {failed} case(s) failed (see the status column)");
         return Ok(ExitCode::from(EXIT_CASE_FAILED));
     }
     Ok(gate_code)
+}
+
+/// The results table on stdout: one row per case, the timings, every metric of the table, the status.
+fn print_table(results: &[CaseResult]) {
+    let width = |label: &str| label.chars().count().max(9);
+    let mut header = format!(
+        "{:<14} {:<16} {:>7} {:>9} {:>8} {:>9} {:>6}",
+        "scenario", "method", "#V", "precomp s", "bind s", "iter ms", "iters"
+    );
+    for spec in &METRICS {
+        header.push_str(&format!(" {:>w$}", spec.label, w = width(spec.label)));
+    }
+    println!("{header}  status");
+    for r in results {
+        let mut line = format!(
+            "{:<14} {:<16} {:>7} {:>9.4} {:>8.4} {:>9.3} {:>6}",
+            r.scenario, r.method, r.vertices, r.precompute_s, r.bind_s, r.median_iteration_ms, r.iterations
+        );
+        for spec in &METRICS {
+            line.push_str(&format!(
+                " {:>w$}",
+                spec.format.apply(r.quality.get(spec.metric)),
+                w = width(spec.label)
+            ));
+        }
+        println!("{line}  {}", r.status);
+    }
 }

@@ -8,14 +8,8 @@ use std::path::{Path, PathBuf};
 
 use crate::case::CaseResult;
 use crate::error::HarnessError;
-
-/// What the regression gate said about the run, for the page.
-pub enum Verdict {
-    /// Compared with the baseline: the findings as text, and whether any is a regression.
-    Checked { findings: Vec<String>, regressions: usize },
-    /// Not compared, and why.
-    NotChecked(String),
-}
+use crate::metrics::METRICS;
+use crate::regression::GateOutcome;
 
 /// Escape text for HTML element content and attribute values.
 fn escape(text: &str) -> String {
@@ -38,7 +32,7 @@ pub fn render_index(
     data_source: &str,
     images: &[PathBuf],
     table1_markdown: &str,
-    verdict: &Verdict,
+    gate: &GateOutcome,
 ) -> String {
     let mut page = String::new();
     page.push_str(concat!(
@@ -48,7 +42,9 @@ pub fn render_index(
         "table{border-collapse:collapse;font-size:13px;margin:1em 0}\n",
         "th,td{border:1px solid #ccc;padding:3px 7px;text-align:right}\n",
         "th{background:#f0f0f0}td.text{text-align:left}\n",
-        "tr.failed td{background:#fdd}\n",
+        "tr.failed td{background:#fdd}tr.suspect td{background:#fff1d6}\n",
+        "td.status{min-width:260px;max-width:360px;font-size:12px}td{white-space:nowrap}\n",
+        "td.status{white-space:normal}div.scroll{overflow-x:auto}dl.metrics dt{font-weight:bold;margin-top:.3em}\n",
         ".pass{color:#060}.fail{color:#a00}\n",
         "img{max-width:100%;border:1px solid #ddd;margin:4px 0}\n",
         "figure{margin:1em 0}figcaption{font-size:13px;color:#555}\n",
@@ -57,54 +53,74 @@ pub fn render_index(
     ));
     let _ = writeln!(
         page,
-        "<p>Data: {}. Angles in degrees (E_θ: RMS change of the triangle corner angles; E_φ: RMS change of the \
-         dihedral angles of interior edges). Times in seconds, iteration times in milliseconds; residual and \
-         RMS to <code>arap</code> relative to the rest bounding-box diagonal.</p>",
+        "<p>Data: {}. Times in seconds, iteration times in milliseconds. Every measure compares the result \
+         with the rest mesh:</p>",
         escape(data_source)
+    );
+    page.push_str("<dl class=\"metrics\">\n");
+    for spec in &METRICS {
+        let unit = if spec.unit.is_empty() { String::new() } else { format!(" ({})", spec.unit) };
+        let _ = writeln!(
+            page,
+            "<dt>{}{} <code>{}</code></dt><dd>{}</dd>",
+            escape(spec.label),
+            escape(&unit),
+            spec.key,
+            escape(spec.doc)
+        );
+    }
+    page.push_str(
+        "</dl>\n<p>Status: <code>ok</code>; <code>suspect</code> (highlighted) when the result folds, misses its \
+         handles or leaves its frame, with the reasons (thresholds in <code>configs/verdicts.toml</code>); \
+         <code>failed</code> (red) when the method gave no result.</p>\n",
     );
 
     page.push_str("<h2 id=\"verdict\">Quality regression gate</h2>\n");
-    match verdict {
-        Verdict::Checked { findings, regressions } => {
-            if *regressions == 0 {
-                page.push_str(
-                    "<p class=\"pass\">No regression against <code>reports/baseline.json</code>.</p>\n",
-                );
+    match gate {
+        GateOutcome::Checked { baseline, findings } => {
+            let regressions = gate.regressions();
+            let name = escape(&baseline.display().to_string());
+            if regressions == 0 {
+                let _ = writeln!(page, "<p class=\"pass\">No regression against <code>{name}</code>.</p>");
             } else {
                 let _ = writeln!(
                     page,
-                    "<p class=\"fail\">{regressions} regression(s) against <code>reports/baseline.json</code>:</p>"
+                    "<p class=\"fail\">{regressions} regression(s) against <code>{name}</code>:</p>"
                 );
             }
             if !findings.is_empty() {
                 page.push_str("<ul>\n");
                 for f in findings {
-                    let _ = writeln!(page, "<li>{}</li>", escape(f));
+                    let _ = writeln!(page, "<li>{}</li>", escape(&f.to_string()));
                 }
                 page.push_str("</ul>\n");
             }
         }
-        Verdict::NotChecked(reason) => {
+        GateOutcome::NotChecked(reason) => {
             let _ = writeln!(page, "<p>Not checked: {}</p>", escape(reason));
         }
     }
 
-    page.push_str("<h2 id=\"results\">Results</h2>\n<table>\n<tr><th>scenario</th><th>method</th><th>#V</th>\
-                   <th>E_θ</th><th>E_φ</th><th>iterations</th><th>converged</th><th>precompute</th><th>bind</th>\
-                   <th>solve</th><th>total</th><th>iteration (ms)</th><th>residual</th><th>RMS to arap</th>\
-                   <th>self-intersecting (open3d)</th><th>status</th></tr>\n");
+    page.push_str(
+        "<h2 id=\"results\">Results</h2>\n<div class=\"scroll\"><table>\n<tr><th>scenario</th><th>method</th>\
+         <th>status</th><th>#V</th>\
+         <th>iterations</th><th>converged</th><th>precompute</th><th>bind</th><th>solve</th><th>total</th>\
+         <th>iteration (ms)</th>",
+    );
+    for spec in &METRICS {
+        let _ = write!(page, "<th title=\"{}\">{}</th>", escape(spec.doc), escape(spec.label));
+    }
+    page.push_str("<th>self-intersecting (open3d)</th></tr>\n");
     for r in results {
-        let class = if r.status == "ok" { "" } else { " class=\"failed\"" };
-        let _ = writeln!(
+        let class = format!(" class=\"{}\"", r.status.kind());
+        let _ = write!(
             page,
-            "<tr{class}><td class=\"text\">{}</td><td class=\"text\">{}</td><td>{}</td><td>{}</td><td>{}</td>\
-             <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>\
-             <td>{}</td><td class=\"text\">{}</td></tr>",
+            "<tr{class}><td class=\"text\">{}</td><td class=\"text\">{}</td><td class=\"text status\">{}</td>\
+             <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>",
             escape(&r.scenario),
             escape(&r.method),
+            escape(&r.status.to_string()),
             r.vertices,
-            number(r.e_theta_deg, 3),
-            number(r.e_phi_deg, 3),
             r.iterations,
             if r.converged { "yes" } else { "no" },
             number(r.precompute_s, 3),
@@ -112,13 +128,17 @@ pub fn render_index(
             number(r.solve_s, 3),
             number(r.total_s, 3),
             number(r.median_iteration_ms, 3),
-            if r.handle_residual_over_diag.is_finite() { format!("{:.1e}", r.handle_residual_over_diag) } else { "–".into() },
-            r.rms_to_arap_over_diag.map_or("–".into(), |v| format!("{v:.1e}")),
+        );
+        for spec in &METRICS {
+            let _ = write!(page, "<td>{}</td>", escape(&spec.format.apply(r.quality.get(spec.metric))));
+        }
+        let _ = writeln!(
+            page,
+            "<td>{}</td></tr>",
             r.self_intersecting.map_or("not checked", |b| if b { "yes" } else { "no" }),
-            escape(&r.status),
         );
     }
-    page.push_str("</table>\n");
+    page.push_str("</table></div>\n");
 
     let (figures, plots): (Vec<&PathBuf>, Vec<&PathBuf>) = images
         .iter()
@@ -152,7 +172,7 @@ pub fn render_index(
         let _ = writeln!(
             page,
             "<h2 id=\"renders\">Every render</h2>\n<details><summary>{} images: rest shapes, results and \
-             angle-error heat maps (0–10°) of every case</summary>",
+             angle-error heat maps (0–10°) and area-distortion maps (×0.5–×2) of every case</summary>",
             single.len()
         );
         for p in single {

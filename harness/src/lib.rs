@@ -15,5 +15,6 @@ pub mod render;
 pub mod report;
 pub mod scenario;
 pub mod suite;
+pub mod verdict;
 
 pub use error::HarnessError;

@@ -1,22 +1,376 @@
-//! Quality metrics of a deformation result (scale-aware paper, section 5.1), in degrees.
+//! Quality measures of a deformation result against its rest mesh, in one table ([`METRICS`]) that
+//! the CSV/JSON writers, the printed table, `index.html`, the plots and the regression gate all read.
+//! A new measure is one [`Metric`] variant, one [`MetricSpec`] row and its function.
+//!
+//! The angle errors are the scale-aware paper's (Liu et al. 2011, sec. 5.1); they are blind to
+//! uniform scaling and to folds, which the area, length, volume and fold measures see.
 
-use meshes::geometry::{corner_angles, dihedral_angles};
+use std::fmt;
+
+use meshes::geometry::{corner_angles, dihedral_angles, edge_lengths, face_areas, signed_volume};
 use meshes::vector::{norm, sub};
 use meshes::{Topology, TriMesh};
 use methods::{HandleSet, HandleTargets};
+use serde::de::{IgnoredAny, MapAccess, Visitor};
+use serde::ser::SerializeMap;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-/// Angles of the rest mesh, computed once per scenario.
-pub struct RestAngles {
-    corners: Vec<[f64; 3]>,
-    dihedrals: Vec<f64>,
+/// Every measure of a result. The order is the column order of the reports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Metric {
+    ETheta,
+    EPhi,
+    EArea,
+    ELength,
+    VolumeChange,
+    Folds,
+    HandleResidual,
+    RmsToArap,
+    MaxToArap,
 }
 
-impl RestAngles {
-    /// Corner and dihedral angles of `mesh` (radians).
+/// Which way a measure is better, for the gate and the plots.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Better {
+    /// Smaller values are better (the measure is non-negative).
+    Lower,
+    /// Values nearer 0 are better (a signed change).
+    NearZero,
+}
+
+/// How much worse than the baseline a gated measure may get: it regresses when its badness
+/// (the value, or its magnitude for [`Better::NearZero`]) exceeds the baseline's by more than both
+/// `relative x |baseline|` and `absolute`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerance {
+    pub relative: f64,
+    /// In the measure's unit.
+    pub absolute: f64,
+}
+
+/// How a metric's value is printed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// `digits` decimals.
+    Fixed(usize),
+    /// Scientific with `digits` decimals of the mantissa.
+    Scientific(usize),
+    /// As a percentage with `digits` decimals.
+    Percent(usize),
+    /// With its sign, `digits` decimals.
+    Signed(usize),
+}
+
+impl Format {
+    /// `value` in this format; `–` for none or non-finite.
+    pub fn apply(self, value: Option<f64>) -> String {
+        match value.filter(|v| v.is_finite()) {
+            None => "–".to_string(),
+            Some(v) => match self {
+                Format::Fixed(d) => format!("{v:.d$}"),
+                Format::Scientific(d) => format!("{v:.d$e}"),
+                Format::Percent(d) => format!("{:.d$}%", 100.0 * v),
+                Format::Signed(d) => format!("{v:+.d$}"),
+            },
+        }
+    }
+}
+
+/// What a measure is computed from: one result on its scenario's rest mesh.
+pub struct Evaluation<'a> {
+    pub rest: &'a RestGeometry,
+    pub mesh: &'a TriMesh,
+    pub topology: &'a Topology,
+    /// `#V x 3` result positions on the rest connectivity.
+    pub result: &'a [[f64; 3]],
+    /// The last edit step's handle set and targets.
+    pub handles: &'a HandleSet,
+    pub targets: &'a HandleTargets,
+    /// `#V x 3` result of the reference method (`arap`) on the same scenario, if it has one.
+    pub reference: Option<&'a [[f64; 3]]>,
+}
+
+/// One row of the metric table.
+pub struct MetricSpec {
+    pub metric: Metric,
+    /// Column name in results.csv/json and the baseline (with its unit, e.g. `_deg`).
+    pub key: &'static str,
+    /// Short name for tables and plots.
+    pub label: &'static str,
+    /// Unit for people (empty: dimensionless).
+    pub unit: &'static str,
+    /// What it measures, with its formula (shown on index.html; the README has the same).
+    pub doc: &'static str,
+    pub better: Better,
+    /// `None`: reported, not gated.
+    pub gate: Option<Tolerance>,
+    /// Shown in the per-test errors plot.
+    pub plotted: bool,
+    /// How a value is printed in tables.
+    pub format: Format,
+    /// The value for a result; `None` where it does not apply (e.g. the volume of an open mesh).
+    pub compute: fn(&Evaluation) -> Option<f64>,
+}
+
+/// The metric table, in [`Metric`] order.
+pub const METRICS: [MetricSpec; 9] = [
+    MetricSpec {
+        metric: Metric::ETheta,
+        key: "e_theta_deg",
+        label: "E_θ",
+        unit: "°",
+        doc: "RMS over all triangle corners of the change of the corner angle, sqrt(mean (θ − θ⁰)²)",
+        better: Better::Lower,
+        gate: Some(Tolerance { relative: 0.02, absolute: 0.01 }),
+        plotted: true,
+        format: Format::Fixed(3),
+        compute: |e| Some(angle_errors(e.rest, e.mesh, e.topology, e.result).0),
+    },
+    MetricSpec {
+        metric: Metric::EPhi,
+        key: "e_phi_deg",
+        label: "E_φ",
+        unit: "°",
+        doc: "RMS over interior edges of the change of the dihedral angle (between the two face normals)",
+        better: Better::Lower,
+        gate: Some(Tolerance { relative: 0.02, absolute: 0.01 }),
+        plotted: true,
+        format: Format::Fixed(3),
+        compute: |e| Some(angle_errors(e.rest, e.mesh, e.topology, e.result).1),
+    },
+    MetricSpec {
+        metric: Metric::EArea,
+        key: "e_area",
+        label: "e_area",
+        unit: "",
+        doc: "area distortion: RMS over faces of ln(A_f / A_f⁰); |2 ln s| for a uniform scaling by s",
+        better: Better::Lower,
+        // 0.001 is a 0.1% area change: below what a figure shows, above round-off.
+        gate: Some(Tolerance { relative: 0.02, absolute: 0.001 }),
+        plotted: true,
+        format: Format::Fixed(4),
+        compute: |e| Some(area_distortion(e.rest, e.mesh, e.result)),
+    },
+    MetricSpec {
+        metric: Metric::ELength,
+        key: "e_length",
+        label: "e_length",
+        unit: "",
+        doc: "length distortion: RMS over edges of ln(ℓ_e / ℓ_e⁰); |ln s| for a uniform scaling by s",
+        better: Better::Lower,
+        gate: Some(Tolerance { relative: 0.02, absolute: 0.001 }),
+        plotted: true,
+        format: Format::Fixed(4),
+        compute: |e| Some(length_distortion(e.rest, e.topology, e.result)),
+    },
+    MetricSpec {
+        metric: Metric::VolumeChange,
+        key: "volume_change",
+        label: "ΔV/V⁰",
+        unit: "",
+        doc: "(V − V⁰) / V⁰ of the enclosed volume, for closed meshes (empty for open ones)",
+        better: Better::NearZero,
+        gate: Some(Tolerance { relative: 0.02, absolute: 0.001 }),
+        plotted: false,
+        format: Format::Signed(3),
+        compute: |e| volume_change(e.rest, e.mesh, e.result),
+    },
+    MetricSpec {
+        metric: Metric::Folds,
+        key: "folds",
+        label: "folds",
+        unit: "",
+        doc: "fraction of interior edges whose dihedral angle changed by more than 90°",
+        better: Better::Lower,
+        // One folded edge in 10^5 is a change; fewer is not measurable on the survey meshes.
+        gate: Some(Tolerance { relative: 0.02, absolute: 1e-5 }),
+        plotted: false,
+        format: Format::Percent(3),
+        compute: |e| Some(folds(e.rest, e.mesh, e.topology, e.result)),
+    },
+    MetricSpec {
+        metric: Metric::HandleResidual,
+        key: "handle_residual_over_diag",
+        label: "residual",
+        unit: "diag",
+        doc: "largest distance of a constrained vertex from its target, over the rest bbox diagonal",
+        better: Better::Lower,
+        // Not gated: hard constraints give round-off, which has no stable relative value; a residual
+        // that matters makes the case suspect, which the gate does see.
+        gate: None,
+        plotted: false,
+        format: Format::Scientific(1),
+        compute: |e| Some(handle_residual(e.handles, e.targets, e.result, e.rest.diagonal)),
+    },
+    MetricSpec {
+        metric: Metric::RmsToArap,
+        key: "rms_to_arap_over_diag",
+        label: "RMS to arap",
+        unit: "diag",
+        doc: "RMS vertex distance to the arap result of the same scenario, over the rest bbox diagonal",
+        better: Better::Lower,
+        gate: None,
+        plotted: false,
+        format: Format::Scientific(1),
+        compute: |e| e.reference.map(|r| rms_distance(e.result, r, e.rest.diagonal)),
+    },
+    MetricSpec {
+        metric: Metric::MaxToArap,
+        key: "max_to_arap_over_diag",
+        label: "max to arap",
+        unit: "diag",
+        doc: "largest vertex distance to the arap result of the same scenario, over the rest bbox diagonal",
+        better: Better::Lower,
+        gate: None,
+        plotted: false,
+        format: Format::Scientific(1),
+        compute: |e| e.reference.map(|r| max_distance(e.result, r, e.rest.diagonal)),
+    },
+];
+
+impl Metric {
+    /// Every metric, in table order.
+    pub const ALL: [Metric; 9] = [
+        Metric::ETheta,
+        Metric::EPhi,
+        Metric::EArea,
+        Metric::ELength,
+        Metric::VolumeChange,
+        Metric::Folds,
+        Metric::HandleResidual,
+        Metric::RmsToArap,
+        Metric::MaxToArap,
+    ];
+
+    /// Its row of [`METRICS`].
+    pub fn spec(self) -> &'static MetricSpec {
+        &METRICS[self as usize]
+    }
+
+    /// The column name.
+    pub fn key(self) -> &'static str {
+        self.spec().key
+    }
+
+    /// The metric with column name `key`.
+    pub fn from_key(key: &str) -> Option<Metric> {
+        Metric::ALL.into_iter().find(|m| m.key() == key)
+    }
+
+    /// How bad `value` is, for comparisons: the value, or its magnitude for a signed change.
+    pub fn badness(self, value: f64) -> f64 {
+        match self.spec().better {
+            Better::Lower => value,
+            Better::NearZero => value.abs(),
+        }
+    }
+}
+
+impl fmt::Display for Metric {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.key())
+    }
+}
+
+/// The value of every metric of one result (`None`: not applicable or not computed). Written into
+/// results.json as one field per metric key (`null` for none).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Quality {
+    values: [Option<f64>; Metric::ALL.len()],
+}
+
+impl Quality {
+    /// Every metric of the result in `evaluation`.
+    pub fn evaluate(evaluation: &Evaluation) -> Quality {
+        let mut quality = Quality::default();
+        for spec in &METRICS {
+            quality.set(spec.metric, (spec.compute)(evaluation));
+        }
+        quality
+    }
+
+    pub fn get(&self, metric: Metric) -> Option<f64> {
+        self.values[metric as usize]
+    }
+
+    /// The value, NaN where there is none.
+    pub fn value(&self, metric: Metric) -> f64 {
+        self.get(metric).unwrap_or(f64::NAN)
+    }
+
+    pub fn set(&mut self, metric: Metric, value: Option<f64>) {
+        self.values[metric as usize] = value;
+    }
+
+    /// The metrics whose value is present and not finite.
+    pub fn non_finite(&self) -> impl Iterator<Item = Metric> + '_ {
+        Metric::ALL.into_iter().filter(|m| self.get(*m).is_some_and(|v| !v.is_finite()))
+    }
+}
+
+impl Serialize for Quality {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut map = serializer.serialize_map(Some(Metric::ALL.len()))?;
+        for m in Metric::ALL {
+            // NaN is not JSON; a missing value is null either way.
+            map.serialize_entry(m.key(), &self.get(m).filter(|v| v.is_finite()))?;
+        }
+        map.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for Quality {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct QualityVisitor;
+        impl<'de> Visitor<'de> for QualityVisitor {
+            type Value = Quality;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("metric values by key")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Quality, A::Error> {
+                let mut quality = Quality::default();
+                while let Some(key) = map.next_key::<String>()? {
+                    match Metric::from_key(&key) {
+                        Some(m) => quality.set(m, map.next_value::<Option<f64>>()?),
+                        None => {
+                            map.next_value::<IgnoredAny>()?;
+                        }
+                    }
+                }
+                Ok(quality)
+            }
+        }
+        deserializer.deserialize_map(QualityVisitor)
+    }
+}
+
+/// Geometry of the rest mesh the measures compare with, computed once per scenario.
+pub struct RestGeometry {
+    /// `#F x 3` corner angles (radians).
+    corners: Vec<[f64; 3]>,
+    /// One per interior edge, in [`Topology::interior_edges`] order (radians).
+    dihedrals: Vec<f64>,
+    /// `#F` face areas.
+    areas: Vec<f64>,
+    /// `#E` edge lengths, in [`Topology::edges`] order.
+    lengths: Vec<f64>,
+    /// Enclosed volume, for a closed mesh.
+    volume: Option<f64>,
+    /// Bounding-box diagonal.
+    pub diagonal: f64,
+}
+
+impl RestGeometry {
+    /// The rest geometry of `mesh`.
     pub fn new(mesh: &TriMesh, topology: &Topology) -> Self {
+        let (p, t) = (mesh.positions(), mesh.triangles());
         Self {
-            corners: corner_angles(mesh.positions(), mesh.triangles()),
-            dihedrals: dihedral_angles(mesh.positions(), mesh.triangles(), topology),
+            corners: corner_angles(p, t),
+            dihedrals: dihedral_angles(p, t, topology),
+            areas: face_areas(p, t),
+            lengths: edge_lengths(p, topology.edges()),
+            volume: topology.is_closed().then(|| signed_volume(p, t)),
+            diagonal: mesh.bbox_diagonal(),
         }
     }
 }
@@ -26,7 +380,7 @@ impl RestAngles {
 /// the dihedral angles of all interior edges (the angle between the two adjacent face normals).
 /// Both are 0 for rigid motions and uniform scalings.
 pub fn angle_errors(
-    rest: &RestAngles,
+    rest: &RestGeometry,
     mesh: &TriMesh,
     topology: &Topology,
     result: &[[f64; 3]],
@@ -36,6 +390,47 @@ pub fn angle_errors(
     let dihedrals = dihedral_angles(result, mesh.triangles(), topology);
     let e_phi = rms(rest.dihedrals.iter().zip(&dihedrals).map(|(a, b)| a - b));
     (e_theta.to_degrees(), e_phi.to_degrees())
+}
+
+/// `e_area = sqrt(mean_f ln(A_f / A_f⁰)²)` over the faces of positive rest area (a rest face of zero
+/// area has no ratio; meshes are checked non-degenerate on load, so none is left out there). A
+/// result face of zero area gives infinity: a collapsed face is infinitely distorted.
+pub fn area_distortion(rest: &RestGeometry, mesh: &TriMesh, result: &[[f64; 3]]) -> f64 {
+    let areas = face_areas(result, mesh.triangles());
+    rms(rest.areas.iter().zip(&areas).filter(|(a0, _)| **a0 > 0.0).map(|(a0, a)| (a / a0).ln()))
+}
+
+/// `e_length = sqrt(mean_e ln(ℓ_e / ℓ_e⁰)²)` over the edges of positive rest length.
+pub fn length_distortion(rest: &RestGeometry, topology: &Topology, result: &[[f64; 3]]) -> f64 {
+    let lengths = edge_lengths(result, topology.edges());
+    rms(rest.lengths.iter().zip(&lengths).filter(|(l0, _)| **l0 > 0.0).map(|(l0, l)| (l / l0).ln()))
+}
+
+/// `(V - V⁰) / V⁰` of the signed enclosed volume; `None` for an open mesh or a rest volume that is
+/// round-off (below `1e-12 x diagonal³`).
+pub fn volume_change(rest: &RestGeometry, mesh: &TriMesh, result: &[[f64; 3]]) -> Option<f64> {
+    let v0 = rest.volume?;
+    if v0.abs() <= 1e-12 * rest.diagonal.powi(3) {
+        return None;
+    }
+    Some((signed_volume(result, mesh.triangles()) - v0) / v0)
+}
+
+/// Dihedral angle change (radians) beyond which an interior edge counts as folded: its two faces
+/// turned against each other by more than a right angle. A smooth deformation of a mesh bends an edge
+/// by a few degrees; 90° is reached only where a sheet doubles back over itself.
+pub const FOLD_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
+
+/// Fraction of interior edges whose dihedral angle changed by more than [`FOLD_ANGLE`] (0 for a mesh
+/// without interior edges).
+pub fn folds(rest: &RestGeometry, mesh: &TriMesh, topology: &Topology, result: &[[f64; 3]]) -> f64 {
+    let dihedrals = dihedral_angles(result, mesh.triangles(), topology);
+    let folded = rest.dihedrals.iter().zip(&dihedrals).filter(|(a, b)| (*a - *b).abs() > FOLD_ANGLE).count();
+    if dihedrals.is_empty() {
+        0.0
+    } else {
+        folded as f64 / dihedrals.len() as f64
+    }
 }
 
 /// Largest distance of a constrained vertex from its target, divided by `diagonal`.
@@ -58,6 +453,23 @@ pub fn rms_distance(a: &[[f64; 3]], b: &[[f64; 3]], diagonal: f64) -> f64 {
     rms(a.iter().zip(b).map(|(p, q)| norm(sub(*p, *q)))) / diagonal
 }
 
+/// Largest vertex distance between two `#V x 3` position arrays, divided by `diagonal` (NaN if a
+/// distance is NaN).
+pub fn max_distance(a: &[[f64; 3]], b: &[[f64; 3]], diagonal: f64) -> f64 {
+    a.iter().zip(b).map(|(p, q)| norm(sub(*p, *q))).fold(0.0, |m: f64, d| {
+        if d.is_nan() || m.is_nan() {
+            f64::NAN
+        } else {
+            m.max(d)
+        }
+    }) / diagonal
+}
+
+/// Largest distance of any vertex of the `#V x 3` `result` from its rest position.
+pub fn largest_displacement(rest: &[[f64; 3]], result: &[[f64; 3]]) -> f64 {
+    max_distance(rest, result, 1.0)
+}
+
 fn rms(values: impl Iterator<Item = f64>) -> f64 {
     let (sum, count) = values.fold((0.0, 0usize), |(s, c), v| (s + v * v, c + 1));
     if count == 0 {
@@ -73,47 +485,190 @@ mod tests {
     use meshes::shapes::{generate, ShapeKind};
     use meshes::AffineTransform;
 
-    fn errors_after(kind: ShapeKind, f: impl Fn([f64; 3]) -> [f64; 3]) -> (f64, f64) {
+    /// The survey-like shape `kind` and its rest geometry.
+    fn shape(kind: ShapeKind) -> (TriMesh, Topology, RestGeometry) {
         let mesh = generate(kind, 1500).unwrap().mesh;
         let topology = Topology::new(&mesh).unwrap();
-        let rest = RestAngles::new(&mesh, &topology);
+        let rest = RestGeometry::new(&mesh, &topology);
+        (mesh, topology, rest)
+    }
+
+    /// Every metric of `mesh` moved by `f` (handles: vertex 0 at its moved position; reference:
+    /// the moved shape itself).
+    fn quality_after(kind: ShapeKind, f: impl Fn([f64; 3]) -> [f64; 3]) -> Quality {
+        let (mesh, topology, rest) = shape(kind);
         let moved: Vec<[f64; 3]> = mesh.positions().iter().map(|&p| f(p)).collect();
-        angle_errors(&rest, &mesh, &topology, &moved)
+        let handles = HandleSet::new(
+            vec![methods::HandleRegion { name: "h".into(), vertices: vec![0] }],
+            mesh.n_vertices(),
+        )
+        .unwrap();
+        let targets = HandleTargets::new(&handles, vec![moved[0]]).unwrap();
+        Quality::evaluate(&Evaluation {
+            rest: &rest,
+            mesh: &mesh,
+            topology: &topology,
+            result: &moved,
+            handles: &handles,
+            targets: &targets,
+            reference: Some(&moved),
+        })
     }
 
     #[test]
-    fn rigid_motions_and_uniform_scalings_have_zero_angle_error() {
+    fn the_table_is_in_enum_order_with_unique_keys() {
+        for (i, m) in Metric::ALL.iter().enumerate() {
+            assert_eq!(METRICS[i].metric, *m);
+            assert_eq!(Metric::from_key(m.key()), Some(*m));
+        }
+        let mut keys: Vec<&str> = METRICS.iter().map(|s| s.key).collect();
+        keys.sort();
+        keys.dedup();
+        assert_eq!(keys.len(), METRICS.len());
+    }
+
+    #[test]
+    fn every_measure_is_zero_for_a_rigid_motion() {
         let rigid = AffineTransform::rotation_about([1.0, -2.0, 0.5], 2.3, [0.3, 0.1, 7.0])
             .compose(&AffineTransform::translation([10.0, -4.0, 3.0]));
-        for kind in [ShapeKind::Bar, ShapeKind::Cactus, ShapeKind::BumpyPlane] {
-            let (t, p) = errors_after(kind, |x| rigid.apply(x));
-            assert!(t < 1e-9 && p < 1e-9, "{kind:?} rigid: E_theta {t}, E_phi {p}");
-            let (t, p) = errors_after(kind, |x| [3.7 * x[0], 3.7 * x[1], 3.7 * x[2]]);
-            assert!(t < 1e-9 && p < 1e-9, "{kind:?} scaling: E_theta {t}, E_phi {p}");
+        for kind in [ShapeKind::Bar, ShapeKind::Cylinder, ShapeKind::Cactus, ShapeKind::BumpyPlane] {
+            let q = quality_after(kind, |x| rigid.apply(x));
+            for m in Metric::ALL {
+                let v = q.get(m);
+                if m == Metric::VolumeChange && v.is_none() {
+                    continue;
+                }
+                let v = v.unwrap_or_else(|| panic!("{kind:?} {m}: no value"));
+                assert!(v.abs() < 1e-9, "{kind:?} rigid: {m} = {v}");
+            }
         }
     }
 
     #[test]
+    fn uniform_scaling_gives_the_closed_forms() {
+        for s in [0.5, 1.7, 3.0] {
+            for kind in [ShapeKind::Bar, ShapeKind::Cylinder, ShapeKind::Cactus] {
+                let q = quality_after(kind, |x| [s * x[0] + 1.0, s * x[1] - 2.0, s * x[2]]);
+                let close = |m: Metric, expected: f64| {
+                    let v = q.value(m);
+                    assert!((v - expected).abs() < 1e-9, "{kind:?} s = {s}: {m} = {v}, expected {expected}");
+                };
+                close(Metric::ETheta, 0.0);
+                close(Metric::EPhi, 0.0);
+                close(Metric::Folds, 0.0);
+                close(Metric::EArea, (2.0 * s.ln()).abs());
+                close(Metric::ELength, s.ln().abs());
+                // Only closed look-alikes have a volume.
+                let (_, topology, _) = shape(kind);
+                if topology.is_closed() {
+                    close(Metric::VolumeChange, s.powi(3) - 1.0);
+                } else {
+                    assert_eq!(q.get(Metric::VolumeChange), None, "{kind:?} is open");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_closed_look_alike_has_a_volume() {
+        let closed = [ShapeKind::Bar, ShapeKind::Cylinder, ShapeKind::Cactus]
+            .into_iter()
+            .filter(|k| shape(*k).1.is_closed())
+            .count();
+        assert!(closed > 0, "the closed-form volume test needs a closed shape");
+    }
+
+    /// A flat strip of `2 n` triangles along x (`n + 1` columns of two vertices), folded flat at
+    /// each column of `fold_at`: the strip walks along x and turns back there (the turned part a
+    /// little shorter so no vertex meets another). Each fold turns the faces on one side of the
+    /// column's edge over, a dihedral change of 180 degrees; no other edge bends.
+    fn strip(n: usize, fold_at: &[usize]) -> Vec<[f64; 3]> {
+        let mut x = 0.0;
+        let mut step = 1.0;
+        let mut out = Vec::with_capacity(2 * (n + 1));
+        for i in 0..=n {
+            if i > 0 {
+                x += step;
+            }
+            out.push([x, 0.0, 0.0]);
+            out.push([x, 1.0, 0.0]);
+            if fold_at.contains(&i) {
+                step = -0.9 * step;
+            }
+        }
+        out
+    }
+
+    fn strip_triangles(n: usize) -> Vec<[u32; 3]> {
+        (0..n as u32)
+            .flat_map(|i| [[2 * i, 2 * i + 2, 2 * i + 1], [2 * i + 1, 2 * i + 2, 2 * i + 3]])
+            .collect()
+    }
+
+    #[test]
+    fn folds_counts_the_edges_of_a_fold_made_by_construction() {
+        let n = 10;
+        let mesh = TriMesh::new(strip(n, &[]), strip_triangles(n)).unwrap();
+        let topology = Topology::new(&mesh).unwrap();
+        let rest = RestGeometry::new(&mesh, &topology);
+        let interior = topology.interior_edges().count();
+        assert_eq!(interior, 2 * n - 1);
+        assert_eq!(folds(&rest, &mesh, &topology, mesh.positions()), 0.0);
+        let f = folds(&rest, &mesh, &topology, &strip(n, &[4]));
+        assert!((f - 1.0 / interior as f64).abs() < 1e-12, "one fold: folds {f}, interior edges {interior}");
+        let f = folds(&rest, &mesh, &topology, &strip(n, &[3, 7]));
+        assert!((f - 2.0 / interior as f64).abs() < 1e-12, "a Z: folds {f}, interior edges {interior}");
+        // A bend by less than a right angle is no fold.
+        let bent: Vec<[f64; 3]> = mesh
+            .positions()
+            .iter()
+            .map(|p| if p[0] > 5.0 { [5.0 + 0.5 * (p[0] - 5.0), p[1], 0.8 * (p[0] - 5.0)] } else { *p })
+            .collect();
+        assert_eq!(folds(&rest, &mesh, &topology, &bent), 0.0);
+    }
+
+    #[test]
     fn non_uniform_scaling_and_bending_are_measured() {
-        let (t, p) = errors_after(ShapeKind::Bar, |x| [2.0 * x[0], x[1], x[2]]);
+        let q = quality_after(ShapeKind::Bar, |x| [2.0 * x[0], x[1], x[2]]);
+        let (t, p) = (q.value(Metric::ETheta), q.value(Metric::EPhi));
         assert!(t > 1.0 && p < 1e-9, "stretching a box changes corner angles, not its flat faces: {t}, {p}");
-        // Bending the plane about the y axis changes dihedral angles, and near-isometrically keeps corners.
-        let (t, p) = errors_after(ShapeKind::BumpyPlane, |x| {
+        assert!(q.value(Metric::EArea) > 0.1 && q.value(Metric::ELength) > 0.1);
+        // Bending the plane about the y axis changes dihedral angles, and near-isometrically keeps
+        // corners, areas and lengths.
+        let q = quality_after(ShapeKind::BumpyPlane, |x| {
             let r = 200.0;
             let a = x[0] / r;
             [(r + x[2]) * a.sin(), x[1], (r + x[2]) * a.cos()]
         });
+        let (t, p) = (q.value(Metric::ETheta), q.value(Metric::EPhi));
         assert!(p > 0.05 && t < p * 10.0, "bend: E_theta {t}, E_phi {p}");
+        assert!(q.value(Metric::EArea) < 0.05 && q.value(Metric::Folds) == 0.0);
     }
 
     #[test]
-    fn residual_and_rms_distance() {
+    fn residual_and_distances() {
         let a = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]];
         let b = vec![[0.0, 0.0, 0.0], [1.0, 2.0, 0.0]];
         assert!((rms_distance(&a, &b, 2.0) - (2.0f64).sqrt() / 2.0).abs() < 1e-15);
+        assert!((max_distance(&a, &b, 2.0) - 1.0).abs() < 1e-15);
+        assert!(max_distance(&a, &[[f64::NAN; 3], [1.0, 0.0, 0.0]], 1.0).is_nan());
         let handles =
             HandleSet::new(vec![methods::HandleRegion { name: "h".into(), vertices: vec![1] }], 2).unwrap();
         let targets = HandleTargets::new(&handles, vec![[1.0, 0.5, 0.0]]).unwrap();
         assert!((handle_residual(&handles, &targets, &b, 3.0) - 0.5).abs() < 1e-15);
+    }
+
+    #[test]
+    fn quality_round_trips_through_json_with_null_for_missing_and_non_finite() {
+        let mut q = Quality::default();
+        q.set(Metric::ETheta, Some(1.5));
+        q.set(Metric::EArea, Some(f64::INFINITY));
+        let json = serde_json::to_value(&q).unwrap();
+        assert_eq!(json["e_theta_deg"], 1.5);
+        assert!(json["e_area"].is_null() && json["volume_change"].is_null());
+        let back: Quality = serde_json::from_value(json).unwrap();
+        assert_eq!(back.get(Metric::ETheta), Some(1.5));
+        assert_eq!(back.get(Metric::EArea), None);
+        assert_eq!(q.non_finite().collect::<Vec<_>>(), vec![Metric::EArea]);
     }
 }

@@ -1,5 +1,6 @@
 //! Plots of a run (plotters; every plot as PNG and SVG under `plots/`):
-//! - `<scenario>-errors`: grouped bars of `E_theta` and `E_phi` per method;
+//! - `<scenario>-errors`: one panel per plotted metric of the table (`E_theta`, `E_phi`, `e_area`,
+//!   `e_length`), side by side, a bar per method;
 //! - `<scenario>-timings`: stacked precompute / handle bind / solve time per method;
 //! - `<scenario>-convergence`: step size, `E_theta` and `E_phi` per iteration, one line per method
 //!   (the scale-aware paper's Fig. 6);
@@ -19,9 +20,12 @@ use plotters::prelude::*;
 
 use crate::case::CaseResult;
 use crate::error::HarnessError;
+use crate::metrics::{MetricSpec, METRICS};
 
-/// Pixel size of every plot.
+/// Pixel size of every plot but the errors plot.
 const SIZE: (u32, u32) = (960, 540);
+/// Pixel size of the errors plot (one panel per plotted metric, side by side).
+const ERRORS_SIZE: (u32, u32) = (1500, 560);
 
 /// Method colours, fixed by registry order so a method has the same colour in every plot.
 fn method_color(method: &str) -> RGBColor {
@@ -61,7 +65,7 @@ pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, H
         written.extend(save(dir, &format!("{scenario}-convergence"), &Plot::Convergence(scenario, &cases))?);
     }
     let sweeps: Vec<&CaseResult> =
-        results.iter().filter(|r| r.scenario.contains("-sweep-") && r.status == "ok").collect();
+        results.iter().filter(|r| r.scenario.contains("-sweep-") && !r.status.is_failed()).collect();
     if !sweeps.is_empty() {
         written.extend(save(dir, "scaling", &Plot::Scaling(&sweeps))?);
     }
@@ -88,6 +92,14 @@ enum Plot<'a> {
 }
 
 impl Plot<'_> {
+    /// Pixel size of the plot.
+    fn size(&self) -> (u32, u32) {
+        match self {
+            Plot::Errors(..) => ERRORS_SIZE,
+            _ => SIZE,
+        }
+    }
+
     fn draw<DB: DrawingBackend>(&self, root: Area<'_, DB>) -> DrawResult {
         match self {
             Plot::Errors(scenario, cases) => draw_errors(root, scenario, cases),
@@ -109,7 +121,7 @@ fn save(dir: &Path, stem: &str, plot: &Plot<'_>) -> Result<Vec<PathBuf>, Harness
     // The bitmap backend picks the encoder from the extension, so the temporary name ends in .png.
     let temporary = dir.join(format!("plots/.{stem}.partial.png"));
     {
-        let root = BitMapBackend::new(&temporary, SIZE).into_drawing_area();
+        let root = BitMapBackend::new(&temporary, plot.size()).into_drawing_area();
         plot.draw(root.clone()).map_err(|m| fail(&final_png, m))?;
         root.present().map_err(|e| fail(&final_png, e.to_string()))?;
     }
@@ -118,7 +130,7 @@ fn save(dir: &Path, stem: &str, plot: &Plot<'_>) -> Result<Vec<PathBuf>, Harness
 
     let mut text = String::new();
     {
-        let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
+        let root = SVGBackend::with_string(&mut text, plot.size()).into_drawing_area();
         plot.draw(root.clone()).map_err(|m| fail(&dir.join(&svg), m))?;
         root.present().map_err(|e| fail(&dir.join(&svg), e.to_string()))?;
     }
@@ -208,44 +220,79 @@ fn label_categories<DB: DrawingBackend>(
     Ok(())
 }
 
-/// Grouped bars: per method, `E_theta` (solid) and `E_phi` (lighter), degrees.
+/// One panel per plotted metric of [`METRICS`], side by side, sharing the method names on the left:
+/// a horizontal bar per method (suspect cases hatched lighter, with the word `suspect`).
 fn draw_errors<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &[&CaseResult]) -> DrawResult {
     root.fill(&WHITE).map_err(err)?;
-    let ok: Vec<&&CaseResult> =
-        cases.iter().filter(|c| c.e_theta_deg.is_finite() && c.e_phi_deg.is_finite()).collect();
-    let top = ok.iter().map(|c| c.e_theta_deg.max(c.e_phi_deg)).fold(0.0, f64::max).max(1e-3) * 1.15;
-    let n = cases.len().max(1);
-    let title = format!("{scenario}: angle errors (degrees; lower is better)");
-    let mut chart = category_chart(&root, &title, "degrees", cases, top)?;
-    for (i, c) in cases.iter().enumerate() {
-        let color = method_color(&c.method);
-        let x = i as f64;
-        for (k, value, style) in
-            [(0, c.e_theta_deg, color.filled()), (1, c.e_phi_deg, color.mix(0.45).filled())]
-        {
-            if !value.is_finite() {
-                continue;
-            }
-            let x0 = x + 0.12 + 0.38 * k as f64;
-            chart
-                .draw_series(std::iter::once(Rectangle::new([(x0, 0.0), (x0 + 0.36, value)], style)))
-                .map_err(err)?;
-            chart
-                .draw_series(std::iter::once(Text::new(
-                    format!("{value:.2}"),
-                    (x0 + 0.02, value + 0.02 * top),
-                    ("sans-serif", 12),
-                )))
-                .map_err(err)?;
+    let root = root
+        .titled(
+            &format!("{scenario}: shape errors against the rest mesh (lower is better)"),
+            ("sans-serif", 22),
+        )
+        .map_err(err)?;
+    let plotted: Vec<&MetricSpec> = METRICS.iter().filter(|s| s.plotted).collect();
+    let names_w = 150;
+    let (names, panels) = root.split_horizontally(names_w);
+    let panels = panels.split_evenly((1, plotted.len().max(1)));
+    let n = cases.len().max(1) as f64;
+    let mut row_y: Vec<i32> = Vec::new();
+    for (panel, spec) in panels.iter().zip(&plotted) {
+        let values: Vec<f64> = cases.iter().map(|c| c.metric(spec.metric)).collect();
+        let top = values.iter().filter(|v| v.is_finite()).fold(0.0f64, |m, v| m.max(v.abs())).max(1e-6) * 1.3;
+        let unit = if spec.unit.is_empty() { String::new() } else { format!(" ({})", spec.unit) };
+        let mut chart = ChartBuilder::on(panel)
+            .caption(format!("{}{unit}", spec.label), ("sans-serif", 18))
+            .margin(10)
+            .x_label_area_size(30)
+            .build_cartesian_2d(0.0..top, 0.0..n)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .disable_y_mesh()
+            .y_labels(0)
+            .x_labels(4)
+            .label_style(("sans-serif", 13))
+            .draw()
+            .map_err(err)?;
+        row_y.clear();
+        for (i, (c, value)) in cases.iter().zip(&values).enumerate() {
+            let y = n - 1.0 - i as f64;
+            row_y.push(chart.backend_coord(&(0.0, y + 0.5)).1);
+            let color = method_color(&c.method);
+            let text = if value.is_finite() {
+                let style = if c.status.is_suspect() { color.mix(0.4).filled() } else { color.filled() };
+                chart
+                    .draw_series(std::iter::once(Rectangle::new(
+                        [(0.0, y + 0.15), (value.abs(), y + 0.85)],
+                        style,
+                    )))
+                    .map_err(err)?;
+                let mut text = spec.format.apply(Some(*value));
+                if c.status.is_suspect() {
+                    text.push_str(" suspect");
+                }
+                text
+            } else if c.status.is_failed() {
+                "failed".to_string()
+            } else {
+                "–".to_string()
+            };
+            let at = (value.abs().min(top).max(0.0) + 0.01 * top, y + 0.35);
+            let at = if value.is_finite() { at } else { (0.01 * top, y + 0.35) };
+            chart.draw_series(std::iter::once(Text::new(text, at, ("sans-serif", 12)))).map_err(err)?;
         }
     }
-    let grey = RGBColor(90, 90, 90);
-    swatch_legend(
-        &mut chart,
-        n,
-        top,
-        &[("E_θ (corner angles)", grey.filled()), ("E_φ (dihedral angles)", grey.mix(0.45).filled())],
-    )?;
+    let (_, names_top) = names.get_base_pixel();
+    let style = TextStyle::from(("sans-serif", 14).into_font()).pos(plotters::style::text_anchor::Pos::new(
+        plotters::style::text_anchor::HPos::Right,
+        plotters::style::text_anchor::VPos::Center,
+    ));
+    for (c, y) in cases.iter().zip(&row_y) {
+        // `row_y` is in backend pixels; the names area draws relative to its own corner.
+        names
+            .draw(&Text::new(c.method.clone(), (names_w as i32 - 8, y - names_top), style.clone()))
+            .map_err(err)?;
+    }
     Ok(())
 }
 
@@ -401,6 +448,10 @@ fn draw_scaling<DB: DrawingBackend>(root: Area<'_, DB>, sweeps: &[&CaseResult]) 
         .configure_mesh()
         .x_desc("vertices")
         .y_desc("median iteration (ms)")
+        // Log axes put a label at every mantissa step; a few readable ones are enough.
+        .x_labels(6)
+        .x_label_formatter(&|v| vertex_count_label(*v))
+        .y_label_formatter(&|v| format!("{v}"))
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(err)?;
@@ -409,6 +460,26 @@ fn draw_scaling<DB: DrawingBackend>(root: Area<'_, DB>, sweeps: &[&CaseResult]) 
         labelled_line(&mut chart, line(m), color, color.stroke_width(2), m.to_string())?;
     }
     draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, 14)
+}
+
+/// A vertex count for an axis: `6K`, `50K`, `1.2M`.
+fn vertex_count_label(v: f64) -> String {
+    if v >= 1e6 {
+        format!("{}M", round_to_two_digits(v / 1e6))
+    } else if v >= 1e3 {
+        format!("{}K", round_to_two_digits(v / 1e3))
+    } else {
+        format!("{}", v.round())
+    }
+}
+
+/// `v` rounded to two significant digits, without trailing zeros.
+fn round_to_two_digits(v: f64) -> f64 {
+    if v <= 0.0 || !v.is_finite() {
+        return v;
+    }
+    let scale = 10f64.powi(1 - v.log10().floor() as i32);
+    (v * scale).round() / scale
 }
 
 /// A polyline with a dot on every point, labelled for the legend.

@@ -1,33 +1,22 @@
-//! The quality-regression gate: the committed `reports/baseline.json` holds `E_theta` and `E_phi` of
-//! every (scenario, method) of a survey run; [`check`] compares a run against it and names every
-//! metric that got worse beyond the tolerance, every case that failed or produced a non-finite
-//! metric, and every baseline case the run lacks. Improvements pass (and are listed, so the
+//! The quality-regression gate: a committed baseline per data source (`reports/baselines/survey.json`
+//! for runs on the survey meshes, `reports/baselines/procedural.json` for the procedural look-alikes)
+//! holds the verdict and every gated measure of the metric table ([`crate::metrics::METRICS`]) of
+//! each (scenario, method). [`check`] compares a run against it and names every measure that got
+//! worse beyond its tolerance, every case that turned suspect, failed or produced a non-finite
+//! measure, and every baseline case the run lacks. Improvements pass (and are listed, so the
 //! baseline can be renewed on purpose with `harness baseline`).
 
+use std::collections::BTreeMap;
 use std::fmt;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
 use crate::case::CaseResult;
 use crate::error::HarnessError;
+use crate::metrics::{Metric, METRICS};
 
-/// A metric is worse when it exceeds the baseline by more than both bounds.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Tolerance {
-    /// Relative to the baseline value (0.02: 2%).
-    pub relative: f64,
-    /// In degrees.
-    pub absolute_deg: f64,
-}
-
-impl Default for Tolerance {
-    fn default() -> Self {
-        Self { relative: 0.02, absolute_deg: 0.01 }
-    }
-}
-
-/// One (scenario, method) of the baseline; angles in degrees.
+/// One (scenario, method) of the baseline.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BaselineCase {
     pub scenario: String,
@@ -35,53 +24,75 @@ pub struct BaselineCase {
     /// `survey` or `procedural look-alike` (the `mesh_source` column): a run of the same case on
     /// other data is not compared.
     pub mesh_source: String,
-    pub e_theta_deg: f64,
-    pub e_phi_deg: f64,
+    /// `ok` or `suspect` (the verdict without its reasons).
+    pub verdict: String,
+    /// The gated measures by metric key; a measure without a value (e.g. the volume of an open
+    /// mesh) is absent.
+    pub metrics: BTreeMap<String, f64>,
 }
 
-/// Contents of `reports/baseline.json`.
+/// Contents of a baseline file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Baseline {
-    pub tolerance: Tolerance,
     pub cases: Vec<BaselineCase>,
 }
 
-/// The metrics the gate compares.
-pub const METRICS: [&str; 2] = ["e_theta_deg", "e_phi_deg"];
+/// Which committed baseline a run is compared with, by the data its meshes came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BaselineKind {
+    /// The survey meshes (the resolution sweeps in such a run are procedural; their cases say so).
+    Survey,
+    /// Procedural look-alikes only: a run without survey data.
+    Procedural,
+}
 
-fn metric(case: &CaseResult, name: &str) -> f64 {
-    match name {
-        "e_theta_deg" => case.e_theta_deg,
-        _ => case.e_phi_deg,
+impl BaselineKind {
+    /// The kind for a run's `results`: `Survey` if any case ran on a survey mesh.
+    pub fn of(results: &[CaseResult]) -> BaselineKind {
+        if results.iter().any(|r| r.mesh_source == "survey") {
+            BaselineKind::Survey
+        } else {
+            BaselineKind::Procedural
+        }
+    }
+
+    /// The committed baseline of this kind under the workspace root `root`.
+    pub fn default_path(self, root: &Path) -> PathBuf {
+        root.join("reports/baselines").join(match self {
+            BaselineKind::Survey => "survey.json",
+            BaselineKind::Procedural => "procedural.json",
+        })
     }
 }
 
-fn baseline_metric(case: &BaselineCase, name: &str) -> f64 {
-    match name {
-        "e_theta_deg" => case.e_theta_deg,
-        _ => case.e_phi_deg,
-    }
+/// The metrics the gate compares: every row of the table with a tolerance.
+pub fn gated_metrics() -> impl Iterator<Item = Metric> {
+    METRICS.iter().filter(|s| s.gate.is_some()).map(|s| s.metric)
 }
 
 /// What the gate found about one case.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Finding {
-    /// Worse than the baseline beyond the tolerance.
-    Worse { scenario: String, method: String, metric: &'static str, baseline: f64, current: f64 },
+    /// Worse than the baseline beyond the metric's tolerance.
+    Worse { scenario: String, method: String, metric: Metric, baseline: f64, current: f64 },
+    /// `ok` in the baseline, suspect now.
+    TurnedSuspect { scenario: String, method: String, status: String },
     /// The case did not run to a result.
     Failed { scenario: String, method: String, status: String },
-    /// The case ran but a metric is NaN or infinite.
-    NonFinite { scenario: String, method: String, metric: &'static str },
+    /// The case ran but a gated metric is NaN or infinite.
+    NonFinite { scenario: String, method: String, metric: Metric },
     /// In the baseline, absent from the run.
     Missing { scenario: String, method: String },
     /// Better than the baseline beyond the tolerance (not a failure).
-    Better { scenario: String, method: String, metric: &'static str, baseline: f64, current: f64 },
+    Better { scenario: String, method: String, metric: Metric, baseline: f64, current: f64 },
+    /// Suspect in the baseline, `ok` now (not a failure).
+    NowOk { scenario: String, method: String },
 }
 
 impl Finding {
     /// Whether this finding fails the gate.
     pub fn is_regression(&self) -> bool {
-        !matches!(self, Finding::Better { .. })
+        !matches!(self, Finding::Better { .. } | Finding::NowOk { .. })
     }
 }
 
@@ -91,8 +102,12 @@ impl fmt::Display for Finding {
             Finding::Worse { scenario, method, metric, baseline, current } => write!(
                 f,
                 "worse: {scenario} / {method} / {metric}: {current:.4} against baseline {baseline:.4} (+{:.1}%)",
-                100.0 * (current - baseline) / baseline.abs().max(f64::MIN_POSITIVE)
+                100.0 * (metric.badness(*current) - metric.badness(*baseline))
+                    / baseline.abs().max(f64::MIN_POSITIVE)
             ),
+            Finding::TurnedSuspect { scenario, method, status } => {
+                write!(f, "turned suspect: {scenario} / {method} (ok in the baseline): {status}")
+            }
             Finding::Failed { scenario, method, status } => write!(f, "failed: {scenario} / {method}: {status}"),
             Finding::NonFinite { scenario, method, metric } => {
                 write!(f, "non-finite: {scenario} / {method} / {metric}")
@@ -101,6 +116,9 @@ impl fmt::Display for Finding {
             Finding::Better { scenario, method, metric, baseline, current } => {
                 write!(f, "better: {scenario} / {method} / {metric}: {current:.4} against baseline {baseline:.4}")
             }
+            Finding::NowOk { scenario, method } => {
+                write!(f, "now ok: {scenario} / {method} (suspect in the baseline)")
+            }
         }
     }
 }
@@ -108,16 +126,19 @@ impl fmt::Display for Finding {
 /// A baseline from the cases of a run that have a result (failed cases are left out).
 pub fn baseline_from(results: &[CaseResult]) -> Baseline {
     Baseline {
-        tolerance: Tolerance::default(),
         cases: results
             .iter()
-            .filter(|r| r.status == "ok" && r.e_theta_deg.is_finite() && r.e_phi_deg.is_finite())
+            .filter(|r| !r.status.is_failed())
             .map(|r| BaselineCase {
                 scenario: r.scenario.clone(),
                 method: r.method.clone(),
                 mesh_source: r.mesh_source.clone(),
-                e_theta_deg: r.e_theta_deg,
-                e_phi_deg: r.e_phi_deg,
+                verdict: r.status.kind().to_string(),
+                metrics: gated_metrics()
+                    .filter_map(|m| {
+                        r.quality.get(m).filter(|v| v.is_finite()).map(|v| (m.key().to_string(), v))
+                    })
+                    .collect(),
             })
             .collect(),
     }
@@ -138,36 +159,48 @@ pub fn foreign_cases(baseline: &Baseline, results: &[CaseResult]) -> Vec<String>
         .collect()
 }
 
-/// Compare `results` with `baseline`: every failed or non-finite case of the run, every baseline
-/// case the run lacks, every metric worse (or better) beyond the tolerance. In run order, then
-/// baseline order for the missing ones.
+/// Compare `results` with `baseline`: every failed case, every case that turned suspect, every
+/// non-finite gated metric, every baseline case the run lacks, every metric worse (or better) beyond
+/// its tolerance. In run order, then baseline order for the missing ones.
 pub fn check(baseline: &Baseline, results: &[CaseResult]) -> Vec<Finding> {
     let mut findings = Vec::new();
     for r in results {
         let (scenario, method) = (r.scenario.clone(), r.method.clone());
-        if r.status != "ok" {
-            findings.push(Finding::Failed { scenario, method, status: r.status.clone() });
+        if r.status.is_failed() {
+            findings.push(Finding::Failed { scenario, method, status: r.status.to_string() });
             continue;
         }
         let reference = baseline.cases.iter().find(|b| b.scenario == r.scenario && b.method == r.method);
-        for name in METRICS {
-            let current = metric(r, name);
+        match reference.map(|b| b.verdict.as_str()) {
+            Some("ok") if r.status.is_suspect() => findings.push(Finding::TurnedSuspect {
+                scenario: scenario.clone(),
+                method: method.clone(),
+                status: r.status.to_string(),
+            }),
+            Some("suspect") if r.status.is_ok() => {
+                findings.push(Finding::NowOk { scenario: scenario.clone(), method: method.clone() })
+            }
+            _ => {}
+        }
+        for metric in gated_metrics() {
+            let Some(current) = r.quality.get(metric) else { continue };
             if !current.is_finite() {
                 findings.push(Finding::NonFinite {
                     scenario: scenario.clone(),
                     method: method.clone(),
-                    metric: name,
+                    metric,
                 });
                 continue;
             }
-            let Some(reference) = reference else { continue };
-            let base = baseline_metric(reference, name);
-            let allowed = (baseline.tolerance.relative * base.abs()).max(baseline.tolerance.absolute_deg);
+            let Some(base) = reference.and_then(|b| b.metrics.get(metric.key())).copied() else { continue };
+            let tolerance = metric.spec().gate.expect("gated metrics have a tolerance");
+            let allowed = (tolerance.relative * base.abs()).max(tolerance.absolute);
+            let change = metric.badness(current) - metric.badness(base);
             let (scenario, method) = (scenario.clone(), method.clone());
-            if current - base > allowed {
-                findings.push(Finding::Worse { scenario, method, metric: name, baseline: base, current });
-            } else if base - current > allowed {
-                findings.push(Finding::Better { scenario, method, metric: name, baseline: base, current });
+            if change > allowed {
+                findings.push(Finding::Worse { scenario, method, metric, baseline: base, current });
+            } else if -change > allowed {
+                findings.push(Finding::Better { scenario, method, metric, baseline: base, current });
             }
         }
     }
@@ -177,6 +210,46 @@ pub fn check(baseline: &Baseline, results: &[CaseResult]) -> Vec<Finding> {
         }
     }
     findings
+}
+
+/// What the gate made of a run.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GateOutcome {
+    /// Compared with the baseline at `baseline`.
+    Checked { baseline: PathBuf, findings: Vec<Finding> },
+    /// Not compared, and why.
+    NotChecked(String),
+}
+
+impl GateOutcome {
+    /// The number of findings that fail the gate (0 when not checked).
+    pub fn regressions(&self) -> usize {
+        match self {
+            GateOutcome::Checked { findings, .. } => findings.iter().filter(|f| f.is_regression()).count(),
+            GateOutcome::NotChecked(_) => 0,
+        }
+    }
+}
+
+/// Compare `results` with the baseline file at `path`: `NotChecked` when there is no such file or
+/// the run used other data than the baseline for some case; an error when the file is unreadable.
+pub fn gate(path: &Path, results: &[CaseResult]) -> Result<GateOutcome, HarnessError> {
+    if !path.is_file() {
+        return Ok(GateOutcome::NotChecked(format!(
+            "no baseline at {} (write one with `harness baseline`)",
+            path.display()
+        )));
+    }
+    let baseline = read_baseline(path)?;
+    let foreign = foreign_cases(&baseline, results);
+    if let Some(first) = foreign.first() {
+        return Ok(GateOutcome::NotChecked(format!(
+            "the run used other data than the baseline {} for {} case(s), e.g. {first}",
+            path.display(),
+            foreign.len()
+        )));
+    }
+    Ok(GateOutcome::Checked { baseline: path.to_path_buf(), findings: check(&baseline, results) })
 }
 
 /// Read a baseline file.
@@ -214,16 +287,22 @@ pub fn read_results(path: &Path) -> Result<(Vec<CaseResult>, String), HarnessErr
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::verdict::Status;
 
     fn case(scenario: &str, method: &str, e_theta: f64, e_phi: f64, status: &str) -> CaseResult {
         let json = serde_json::json!({
             "scenario": scenario, "method": method, "mesh_source": "survey", "vertices": 10, "faces": 16,
             "precompute_s": 0.0, "bind_s": 0.0, "median_iteration_ms": 0.0, "iterations": 1, "solve_s": 0.0,
             "total_s": 0.0, "converged": true, "e_theta_deg": e_theta, "e_phi_deg": e_phi,
+            "e_area": 0.1, "e_length": 0.05, "volume_change": -0.2, "folds": 0.0,
             "handle_residual_over_diag": 0.0, "rms_to_arap_over_diag": null, "status": status,
             "phase_timings": [], "statistics": [], "steps": [], "trace": []
         });
-        serde_json::from_value(json).unwrap()
+        let mut c: CaseResult = serde_json::from_value(json).unwrap();
+        // JSON has no NaN: set the non-finite values the tests ask for directly.
+        c.quality.set(Metric::ETheta, Some(e_theta));
+        c.quality.set(Metric::EPhi, Some(e_phi));
+        c
     }
 
     fn baseline() -> Baseline {
@@ -234,26 +313,39 @@ mod tests {
         ])
     }
 
-    #[test]
-    fn identical_results_pass() {
-        let run = [
+    fn run() -> Vec<CaseResult> {
+        vec![
             case("bar", "arap", 2.0, 5.0, "ok"),
             case("bar", "laplacian", 7.0, 2.0, "ok"),
             case("cactus", "arap", 0.1, 0.2, "ok"),
-        ];
-        assert!(check(&baseline(), &run).is_empty());
+        ]
+    }
+
+    #[test]
+    fn identical_results_pass() {
+        assert!(check(&baseline(), &run()).is_empty());
+    }
+
+    #[test]
+    fn the_baseline_holds_every_gated_metric_and_the_verdict() {
+        let b = baseline();
+        let keys: Vec<&str> = b.cases[0].metrics.keys().map(String::as_str).collect();
+        for m in gated_metrics() {
+            assert!(keys.contains(&m.key()), "{m} missing from {keys:?}");
+        }
+        assert!(!keys.contains(&"handle_residual_over_diag"), "not gated");
+        assert_eq!(b.cases[0].verdict, "ok");
     }
 
     #[test]
     fn worse_beyond_both_bounds_is_named() {
         // bar/arap E_theta +3% (beyond 2% and 0.01 deg); bar/laplacian E_phi +1.5% (within 2%);
         // cactus/arap E_theta +0.009 deg (9% but within the absolute 0.01 deg).
-        let run = [
-            case("bar", "arap", 2.06, 5.0, "ok"),
-            case("bar", "laplacian", 7.0, 2.03, "ok"),
-            case("cactus", "arap", 0.109, 0.2, "ok"),
-        ];
-        let findings = check(&baseline(), &run);
+        let mut r = run();
+        r[0].quality.set(Metric::ETheta, Some(2.06));
+        r[1].quality.set(Metric::EPhi, Some(2.03));
+        r[2].quality.set(Metric::ETheta, Some(0.109));
+        let findings = check(&baseline(), &r);
         assert_eq!(findings.len(), 1, "{findings:?}");
         assert!(findings[0].is_regression());
         let text = findings[0].to_string();
@@ -261,12 +353,54 @@ mod tests {
     }
 
     #[test]
+    fn a_regression_of_each_gated_metric_fails_the_gate() {
+        let metrics: Vec<Metric> = gated_metrics().collect();
+        for m in [Metric::EArea, Metric::ELength, Metric::VolumeChange, Metric::Folds] {
+            assert!(metrics.contains(&m), "{m} is gated");
+        }
+        for metric in metrics {
+            let base = baseline();
+            let mut r = run();
+            let before = r[1].quality.value(metric);
+            // Worse by 10% of the value and 10x the absolute tolerance: a signed change gets worse
+            // away from 0.
+            let bump = 0.1 * before.abs() + 10.0 * metric.spec().gate.unwrap().absolute;
+            let worse = if before < 0.0 { before - bump } else { before + bump };
+            r[1].quality.set(metric, Some(worse));
+            let findings = check(&base, &r);
+            assert!(
+                findings.len() == 1 && findings[0].is_regression(),
+                "{metric}: {before} -> {worse}: {findings:?}"
+            );
+            assert!(findings[0].to_string().contains(&format!("bar / laplacian / {metric}")));
+            // The same step towards 0 (or down) is an improvement.
+            let better = if before < 0.0 { before + 0.5 * before.abs() } else { 0.5 * before };
+            r[1].quality.set(metric, Some(better));
+            let findings = check(&base, &r);
+            assert!(findings.iter().all(|f| !f.is_regression()), "{metric}: {findings:?}");
+        }
+    }
+
+    #[test]
+    fn a_case_that_turns_suspect_fails_the_gate_and_one_that_recovers_passes() {
+        let mut r = run();
+        r[0].status = Status::Suspect(vec!["folds: 0.1% of interior edges turned by more than 90°".into()]);
+        let findings = check(&baseline(), &r);
+        assert_eq!(findings.len(), 1, "{findings:?}");
+        assert!(findings[0].is_regression());
+        assert!(findings[0].to_string().starts_with("turned suspect: bar / arap"), "{}", findings[0]);
+        // Suspect in the baseline and still suspect: no new finding; suspect then ok: listed, passes.
+        let suspect_baseline = baseline_from(&r);
+        assert!(check(&suspect_baseline, &r).is_empty());
+        let findings = check(&suspect_baseline, &run());
+        assert!(findings.len() == 1 && !findings[0].is_regression(), "{findings:?}");
+    }
+
+    #[test]
     fn failures_non_finite_and_missing_cases_are_regressions() {
-        let run = [
-            case("bar", "arap", 2.0, f64::NAN, "ok"),
-            case("bar", "laplacian", f64::NAN, f64::NAN, "failed: solver"),
-        ];
-        let findings = check(&baseline(), &run);
+        let r =
+            [case("bar", "arap", 2.0, f64::NAN, "ok"), case("bar", "laplacian", 7.0, 2.0, "failed: solver")];
+        let findings = check(&baseline(), &r);
         let texts: Vec<String> = findings.iter().map(|f| f.to_string()).collect();
         assert!(findings.iter().all(Finding::is_regression), "{texts:?}");
         assert!(texts.iter().any(|t| t.starts_with("non-finite: bar / arap / e_phi_deg")), "{texts:?}");
@@ -276,14 +410,32 @@ mod tests {
 
     #[test]
     fn improvements_pass_but_are_listed() {
-        let run = [
-            case("bar", "arap", 1.0, 5.0, "ok"),
-            case("bar", "laplacian", 7.0, 2.0, "ok"),
-            case("cactus", "arap", 0.1, 0.2, "ok"),
-        ];
-        let findings = check(&baseline(), &run);
+        let mut r = run();
+        r[0].quality.set(Metric::ETheta, Some(1.0));
+        let findings = check(&baseline(), &r);
         assert_eq!(findings.len(), 1);
         assert!(!findings[0].is_regression());
+    }
+
+    #[test]
+    fn the_gate_says_why_it_did_not_compare() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("survey.json");
+        assert!(
+            matches!(gate(&path, &run()).unwrap(), GateOutcome::NotChecked(r) if r.contains("no baseline"))
+        );
+        write_baseline(&path, &baseline()).unwrap();
+        let mut r = run();
+        r[2].mesh_source = "procedural look-alike".into();
+        let outcome = gate(&path, &r).unwrap();
+        assert!(
+            matches!(&outcome, GateOutcome::NotChecked(why) if why.contains("1 case(s), e.g. cactus / arap")),
+            "{outcome:?}"
+        );
+        assert_eq!(gate(&path, &run()).unwrap().regressions(), 0);
+        assert_eq!(BaselineKind::of(&r), BaselineKind::Survey);
+        r.iter_mut().for_each(|c| c.mesh_source = "procedural look-alike".into());
+        assert_eq!(BaselineKind::of(&r), BaselineKind::Procedural);
     }
 
     #[test]

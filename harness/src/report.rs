@@ -9,10 +9,11 @@ use serde::Serialize;
 
 use crate::case::CaseResult;
 use crate::error::HarnessError;
+use crate::metrics::METRICS;
 use crate::scenario::LoadedScenario;
 
-/// CSV columns, with units in the names.
-pub const CSV_COLUMNS: &[&str] = &[
+/// The CSV columns before the metrics, with units in the names.
+const CASE_COLUMNS: &[&str] = &[
     "scenario",
     "method",
     "mesh_source",
@@ -25,13 +26,21 @@ pub const CSV_COLUMNS: &[&str] = &[
     "solve_s",
     "total_s",
     "converged",
-    "e_theta_deg",
-    "e_phi_deg",
-    "handle_residual_over_diag",
-    "rms_to_arap_over_diag",
-    "self_intersecting",
-    "status",
 ];
+
+/// The CSV columns after the metrics.
+const VERDICT_COLUMNS: &[&str] =
+    &["largest_move_over_diag", "largest_handle_move_over_diag", "self_intersecting", "status"];
+
+/// Every column of `results.csv`: the case, every metric of [`METRICS`] by key, the verdict.
+pub fn csv_columns() -> Vec<&'static str> {
+    CASE_COLUMNS
+        .iter()
+        .copied()
+        .chain(METRICS.iter().map(|s| s.key))
+        .chain(VERDICT_COLUMNS.iter().copied())
+        .collect()
+}
 
 #[derive(Serialize)]
 struct JsonReport<'a> {
@@ -54,9 +63,9 @@ fn num(v: f64) -> String {
 pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let err = |e: csv::Error| HarnessError::Report(format!("CSV: {e}"));
-    w.write_record(CSV_COLUMNS).map_err(err)?;
+    w.write_record(csv_columns()).map_err(err)?;
     for r in results {
-        w.write_record([
+        let mut row = vec![
             r.scenario.clone(),
             r.method.clone(),
             r.mesh_source.clone(),
@@ -69,14 +78,15 @@ pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
             num(r.solve_s),
             num(r.total_s),
             r.converged.to_string(),
-            num(r.e_theta_deg),
-            num(r.e_phi_deg),
-            num(r.handle_residual_over_diag),
-            r.rms_to_arap_over_diag.map(num).unwrap_or_default(),
+        ];
+        row.extend(METRICS.iter().map(|s| r.quality.get(s.metric).map(num).unwrap_or_default()));
+        row.extend([
+            num(r.largest_move_over_diag),
+            num(r.largest_handle_move_over_diag),
             r.self_intersecting.map(|b| b.to_string()).unwrap_or_default(),
-            r.status.clone(),
-        ])
-        .map_err(err)?;
+            r.status.to_string(),
+        ]);
+        w.write_record(row).map_err(err)?;
     }
     w.into_inner().map_err(|e| HarnessError::Report(format!("CSV: {e}")))
 }
@@ -86,7 +96,7 @@ pub fn render_json(results: &[CaseResult], data_source: &str) -> Result<Vec<u8>,
     let report = JsonReport {
         generator: concat!("deformbench harness ", env!("CARGO_PKG_VERSION")),
         data_source,
-        units: "times in seconds (median_iteration_ms in milliseconds); angles in degrees; *_over_diag relative to the rest bounding-box diagonal",
+        units: "times in seconds (median_iteration_ms in milliseconds); angles in degrees; *_over_diag relative to the rest bounding-box diagonal; e_area, e_length RMS log ratios; volume_change and folds fractions",
         cases: results,
     };
     // NaN is not JSON: serde_json writes it as null, which is what a missing value should be.

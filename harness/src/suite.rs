@@ -5,11 +5,15 @@ use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::case::{run_case, CaseResult};
+use crate::case::{run_case, CaseResult, Reference};
 use crate::config::MethodParams;
 use crate::error::HarnessError;
-use crate::metrics::{rms_distance, RestAngles};
+use crate::metrics::RestGeometry;
 use crate::scenario::{load_specs, DataSource, LoadedScenario};
+use crate::verdict::VerdictRules;
+
+/// The method every other is compared with (`rms_to_arap_over_diag`, `max_to_arap_over_diag`).
+pub const REFERENCE_METHOD: &str = "arap";
 
 /// Environment variable naming the survey data directory (same as `--survey-dir`).
 pub const SURVEY_DIR_ENV: &str = "DEFORM_SURVEY_DIR";
@@ -48,11 +52,16 @@ impl SuiteOptions {
     }
 }
 
-/// Load and validate the configuration and every selected scenario.
-pub fn prepare(
-    options: &SuiteOptions,
-) -> Result<(MethodParams, Vec<LoadedScenario>, DataSource), HarnessError> {
+/// The configuration of a run: method parameters and verdict rules.
+pub struct RunConfig {
+    pub params: MethodParams,
+    pub rules: VerdictRules,
+}
+
+/// Load and validate the configuration (`methods.toml`, `verdicts.toml`) and every selected scenario.
+pub fn prepare(options: &SuiteOptions) -> Result<(RunConfig, Vec<LoadedScenario>, DataSource), HarnessError> {
     let params = MethodParams::load(&options.configs_dir.join("methods.toml"))?;
+    let rules = VerdictRules::load(&options.configs_dir.join("verdicts.toml"))?;
     for m in &options.methods {
         methods::registry::find(m)?;
     }
@@ -71,13 +80,13 @@ pub fn prepare(
     }
     let source = options.data_source()?;
     let scenarios = specs.iter().map(|s| s.load(&source)).collect::<Result<Vec<_>, _>>()?;
-    Ok((params, scenarios, source))
+    Ok((RunConfig { params, rules }, scenarios, source))
 }
 
-/// Run every selected method on every scenario. `arap` runs first in each scenario so the others can
-/// be compared with it; results are reported in registry order.
+/// Run every selected method on every scenario. [`REFERENCE_METHOD`] runs first in each scenario so
+/// the others can be compared with it; results are reported in registry order.
 pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
-    let (params, scenarios, source) = prepare(options)?;
+    let (config, scenarios, source) = prepare(options)?;
     let plan: Vec<(usize, Vec<&'static str>)> = scenarios
         .iter()
         .enumerate()
@@ -101,21 +110,25 @@ pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
     let mut results = Vec::with_capacity(total);
     for (i, names) in plan {
         let scenario = &scenarios[i];
-        let rest = RestAngles::new(&scenario.mesh, &scenario.topology);
+        let rest = RestGeometry::new(&scenario.mesh, &scenario.topology);
         let mut order = names.clone();
-        order.sort_by_key(|m| *m != "arap");
+        order.sort_by_key(|m| *m != REFERENCE_METHOD);
         let mut cases: Vec<CaseResult> = Vec::with_capacity(order.len());
         for method in order {
             bar.set_message(format!("{} / {method}", scenario.spec.name));
-            cases.push(run_case(scenario, &rest, method, &params.get(method)));
+            let reference = if method == REFERENCE_METHOD {
+                Reference::Itself
+            } else {
+                cases
+                    .iter()
+                    .find(|c| c.method == REFERENCE_METHOD)
+                    .and_then(|c| c.positions.as_deref())
+                    .map_or(Reference::Missing, Reference::Of)
+            };
+            let case =
+                run_case(scenario, &rest, method, &config.params.get(method), &config.rules, reference);
+            cases.push(case);
             bar.inc(1);
-        }
-        let arap = cases.iter().find(|c| c.method == "arap").and_then(|c| c.positions.clone());
-        let diagonal = scenario.mesh.bbox_diagonal();
-        for c in &mut cases {
-            if let (Some(a), Some(p)) = (&arap, &c.positions) {
-                c.rms_to_arap_over_diag = Some(rms_distance(p, a, diagonal));
-            }
         }
         cases.sort_by_key(|c| names.iter().position(|m| *m == c.method));
         results.extend(cases);

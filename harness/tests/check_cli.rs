@@ -1,6 +1,7 @@
 //! The regression gate through the `harness` binary: `baseline` writes a baseline from a run's
 //! results.json, `check` passes on the same results and fails, naming the case and metric, once one
-//! result is made worse on purpose; a failed case and a missing case fail it too.
+//! result is made worse on purpose; a case turning suspect, a failed case and a missing case fail it
+//! too.
 
 use std::path::Path;
 use std::process::Command;
@@ -57,6 +58,14 @@ fn check_names_every_regression_and_passes_identical_results() {
     assert_eq!(code, 3, "{text}");
     assert!(text.contains("cactus / arap / e_theta_deg"), "{text}");
     assert!(!text.contains("bar / arap"), "only the worsened case is named: {text}");
+
+    // A case that turns suspect (same measures).
+    let mut suspect = good;
+    suspect[2].4 = "suspect: folds: 0.647% of interior edges turned by more than 90°";
+    write_results(dir.path(), &suspect);
+    let (code, text) = harness(&["check", "--reports", reports, "--baseline", baseline]);
+    assert_eq!(code, 3, "{text}");
+    assert!(text.contains("turned suspect: cactus / hirm"), "{text}");
 
     // A failed case and a case missing from the run.
     write_results(dir.path(), &[good[0], ("cactus", "arap", f64::NAN, f64::NAN, "failed: linear solver")]);

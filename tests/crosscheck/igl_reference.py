@@ -29,6 +29,9 @@ arap-timing MESH CONSTRAINTS ITERATIONS
     one JSON line on stdout (precompute_s in seconds, ms_per_iteration = best solve / ITERATIONS):
     {"mesh": ..., "vertices": n, "precompute_s": ..., "ms_per_iteration": ..., "iterations": ...}
 
+doublearea MESH OUT
+    igl.doublearea(V, F): twice the area of every face, one value per line, in face order.
+
 harmonic MESH CONSTRAINTS OUT
     CONSTRAINTS: one line per boundary vertex, `index value`. igl.harmonic with k=1.
     OUT: one value per vertex.
@@ -224,6 +227,11 @@ def cmd_arap_timing(args):
 # harmonic
 
 
+def cmd_doublearea(args):
+    V, F = read_mesh(args.mesh)
+    write_matrix(args.out, igl.doublearea(V, F).reshape(-1))
+
+
 def cmd_harmonic(args):
     V, F = read_mesh(args.mesh)
     b, bc = read_scalar_constraints(args.constraints, V.shape[0])
@@ -317,6 +325,11 @@ def build_parser():
     s.add_argument("constraints")
     s.add_argument("iterations", type=positive_int)
     s.set_defaults(func=cmd_arap_timing)
+
+    s = sub.add_parser("doublearea", help="igl.doublearea: twice the face areas")
+    s.add_argument("mesh")
+    s.add_argument("out")
+    s.set_defaults(func=cmd_doublearea)
 
     s = sub.add_parser("harmonic", help="igl.harmonic with k=1")
     s.add_argument("mesh")

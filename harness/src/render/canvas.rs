@@ -56,6 +56,15 @@ impl RgbImage {
         }
     }
 
+    /// The border, `thickness` pixels wide inwards, of the `w x h` rectangle at `(x, y)`, clipped.
+    pub fn outline_rect(&mut self, x: i64, y: i64, w: u32, h: u32, thickness: u32, color: [u8; 3]) {
+        let t = thickness.min(w).min(h);
+        self.fill_rect(x, y, w, t, color);
+        self.fill_rect(x, y + (h - t) as i64, w, t, color);
+        self.fill_rect(x, y, t, h, color);
+        self.fill_rect(x + (w - t) as i64, y, t, h, color);
+    }
+
     /// Copy `src` with its top-left corner at `(x, y)`, clipped to this image.
     pub fn paste(&mut self, src: &RgbImage, x: i64, y: i64) {
         for (px, py) in self.clip(x, y, src.width, src.height) {

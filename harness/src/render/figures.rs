@@ -1,6 +1,11 @@
-//! The report figures: a shaded render and an angle-error heat map of every result, and the two
-//! grids (rows = scenarios, columns = `rest` + methods) the survey and the scale-aware paper
-//! (Fig. 10) present results in.
+//! The report figures: a shaded render, an angle-error heat map and an area-distortion map of every
+//! result, and the three grids (rows = scenarios, columns = `rest` + methods) the survey and the
+//! scale-aware paper (Fig. 10) present results in.
+//!
+//! One camera per row frames the rest shape and the handle targets (each step's targets applied to
+//! the rest shape), never the results: a result that runs away cannot shrink the row to a dot. A
+//! result that leaves that frame is drawn clipped and its cell marked `clipped`; a suspect case is
+//! marked `suspect` (its reasons are in the reports).
 //!
 //! Rows are the scenarios of `scenarios` (in that order) with at least one result; a result whose
 //! scenario is not among them has no rest mesh to render and is left out. Columns are the same for
@@ -14,11 +19,14 @@ use rayon::prelude::*;
 
 use crate::case::CaseResult;
 use crate::error::HarnessError;
+use crate::metrics::Metric;
 use crate::scenario::LoadedScenario;
 
 use super::camera::{Camera, VIEW_FROM};
 use super::canvas::RgbImage;
-use super::heat::{heat_color, vertex_angle_errors, HEAT_MAX_DEG};
+use super::heat::{
+    area_color, heat_color, vertex_angle_errors, vertex_area_distortion, AREA_MAX_LOG, HEAT_MAX_DEG,
+};
 use super::shade::{render, Paint, VertexRole};
 use super::text::{draw_labels, Align, Label};
 
@@ -48,12 +56,14 @@ const RULE: [u8; 3] = [222, 222, 222];
 const EMPTY_CELL: [u8; 3] = [247, 247, 247];
 const FAILED_CELL: [u8; 3] = [250, 238, 238];
 const FAILED_INK: [u8; 3] = [170, 50, 50];
+const SUSPECT_INK: [u8; 3] = [200, 110, 0];
 
 /// Folder of the figures under the report directory.
 const FIGURES: &str = "figures";
 
 /// Write `figures/<scenario>-rest.png`, `figures/<scenario>-<method>.png`,
-/// `figures/<scenario>-<method>-heat.png`, `figures/grid.png`, `figures/grid_heat.png` under `dir`;
+/// `figures/<scenario>-<method>-heat.png`, `figures/<scenario>-<method>-area.png`, `figures/grid.png`,
+/// `figures/grid_heat.png`, `figures/grid_area.png` under `dir`;
 /// returns the paths written, relative to `dir` (for the HTML report).
 ///
 /// `results` are the cases of the run (a result's `positions` are its final `#V x 3` shape on the
@@ -91,19 +101,24 @@ pub fn write_figures(
         let stem = file_name(&row.scenario.spec.name);
         files.push((Path::new(FIGURES).join(format!("{stem}-rest.png")), &images.rest));
         for (case, cell) in row.cases.iter().zip(&images.cells) {
-            if let (Some(case), Cell::Rendered { shaded, heat }) = (case, cell) {
+            if let (Some(case), Cell::Rendered { shaded, heat, area, .. }) = (case, cell) {
                 let stem = format!("{stem}-{}", file_name(&case.method));
                 files.push((Path::new(FIGURES).join(format!("{stem}.png")), shaded));
                 files.push((Path::new(FIGURES).join(format!("{stem}-heat.png")), heat));
+                files.push((Path::new(FIGURES).join(format!("{stem}-area.png")), area));
             }
         }
     }
-    let grid = grid_image(&rows, &rendered, &columns, Kind::Shaded)
-        .map_err(|e| HarnessError::Report(format!("{}: {e}", figures.join("grid.png").display())))?;
-    let grid_heat = grid_image(&rows, &rendered, &columns, Kind::Heat)
-        .map_err(|e| HarnessError::Report(format!("{}: {e}", figures.join("grid_heat.png").display())))?;
-    files.push((Path::new(FIGURES).join("grid.png"), &grid));
-    files.push((Path::new(FIGURES).join("grid_heat.png"), &grid_heat));
+    let grids = [(Kind::Shaded, "grid.png"), (Kind::Heat, "grid_heat.png"), (Kind::Area, "grid_area.png")]
+        .map(|(kind, name)| {
+            grid_image(&rows, &rendered, &columns, kind)
+                .map(|image| (name, image))
+                .map_err(|e| HarnessError::Report(format!("{}: {e}", figures.join(name).display())))
+        });
+    let grids = grids.into_iter().collect::<Result<Vec<_>, _>>()?;
+    for (name, image) in &grids {
+        files.push((Path::new(FIGURES).join(name), image));
+    }
 
     let encoded: Vec<Result<Vec<u8>, HarnessError>> = files
         .par_iter()
@@ -135,19 +150,26 @@ struct RenderedRow {
 enum Cell {
     NotRun,
     Failed,
-    Rendered { shaded: RgbImage, heat: RgbImage },
+    /// `clipped`: part of the result lies outside the row's frame.
+    Rendered {
+        shaded: RgbImage,
+        heat: RgbImage,
+        area: RgbImage,
+        clipped: bool,
+    },
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Kind {
     Shaded,
     Heat,
+    Area,
 }
 
 /// The `#V x 3` result of a case, if it succeeded and fits its rest mesh.
 fn usable_positions<'a>(case: &'a CaseResult, scenario: &LoadedScenario) -> Option<&'a [[f64; 3]]> {
     let positions = case.positions.as_deref()?;
-    (case.status == "ok" && positions.len() == scenario.mesh.n_vertices()).then_some(positions)
+    (!case.status.is_failed() && positions.len() == scenario.mesh.n_vertices()).then_some(positions)
 }
 
 /// Every method with a result, in registry order, then unknown names in order of appearance.
@@ -179,11 +201,28 @@ fn vertex_roles(scenario: &LoadedScenario) -> Vec<VertexRole> {
     roles
 }
 
+/// The positions the row's camera frames: the rest shape and every step's handle targets applied to
+/// the rest shape (a `hold` step's targets are then rest positions, already framed; the actual
+/// targets of later steps start from each method's own result, which the frame must not depend on).
+fn frame_targets(scenario: &LoadedScenario) -> Vec<Vec<[f64; 3]>> {
+    let rest = scenario.mesh.positions();
+    scenario.steps.iter().filter_map(|s| s.targets(rest).ok()).map(|t| t.positions().to_vec()).collect()
+}
+
+/// Whether a finite vertex of `positions` falls outside the `CELL_SIZE` square seen by `camera`.
+fn leaves_frame(camera: &Camera, positions: &[[f64; 3]]) -> bool {
+    let size = CELL_SIZE as f64;
+    positions.iter().filter(|p| p.iter().all(|c| c.is_finite())).any(|&p| {
+        let [x, y, _] = camera.project(p, CELL_SIZE, CELL_SIZE);
+        !(0.0..=size).contains(&x) || !(0.0..=size).contains(&y)
+    })
+}
+
 fn render_row(row: &Row) -> RenderedRow {
     let mesh = &row.scenario.mesh;
     let (rest, triangles) = (mesh.positions(), mesh.triangles());
-    let results = row.cases.iter().flatten().filter_map(|c| usable_positions(c, row.scenario));
-    let camera = Camera::for_shapes(std::iter::once(rest).chain(results), 1.0);
+    let targets = frame_targets(row.scenario);
+    let camera = Camera::for_shapes(std::iter::once(rest).chain(targets.iter().map(Vec::as_slice)), 1.0);
     let roles = vertex_roles(row.scenario);
     let draw = |positions: &[[f64; 3]], paints: &[Paint]| {
         render(&camera, positions, triangles, CELL_SIZE, CELL_SIZE, paints)
@@ -198,9 +237,12 @@ fn render_row(row: &Row) -> RenderedRow {
             let Some(case) = case else { return Cell::NotRun };
             let Some(positions) = usable_positions(case, row.scenario) else { return Cell::Failed };
             let errors = vertex_angle_errors(rest, positions, triangles);
-            let mut images = draw(positions, &[Paint::Roles(&roles), Paint::Heat(&errors)]).into_iter();
-            match (images.next(), images.next()) {
-                (Some(shaded), Some(heat)) => Cell::Rendered { shaded, heat },
+            let areas = vertex_area_distortion(rest, positions, triangles);
+            let paints = [Paint::Roles(&roles), Paint::Heat(&errors), Paint::Area(&areas)];
+            let mut images = draw(positions, &paints).into_iter();
+            let clipped = leaves_frame(&camera, positions);
+            match (images.next(), images.next(), images.next()) {
+                (Some(shaded), Some(heat), Some(area)) => Cell::Rendered { shaded, heat, area, clipped },
                 _ => Cell::Failed,
             }
         })
@@ -228,14 +270,19 @@ fn grid_image(
     let width = 2 * PAD + label_w + n_cols * CELL_SIZE;
     let mut notes = vec![
         format!(
-            "Orthographic view from ({}, {}, {}), z up; one camera per row, framing the rest shape and all \
-             results of the row. Headlight Lambert shading.",
+            "Orthographic view from ({}, {}, {}), z up; one camera per row, framing the rest shape and the \
+             handle targets. A result that leaves that frame is drawn clipped and its cell marked \"clipped\"; \
+             a suspect case is marked \"suspect\" (reasons in the results table). Headlight Lambert shading.",
             VIEW_FROM[0], VIEW_FROM[1], VIEW_FROM[2]
         ),
-        "E\u{3b8} / E\u{3c6}: RMS change of the corner / dihedral angles over the whole mesh (degrees)."
-            .to_string(),
+        if kind == Kind::Area {
+            "e_area: RMS over faces of ln(A / A\u{2070}), the area distortion (0 when areas are kept).".to_string()
+        } else {
+            "E\u{3b8} / E\u{3c6}: RMS change of the corner / dihedral angles over the whole mesh (degrees)."
+                .to_string()
+        },
     ];
-    if kind == Kind::Heat {
+    if kind != Kind::Shaded {
         notes.push("Rest column: fixed vertices blue, handle vertices orange.".to_string());
     }
     let notes = notes
@@ -243,7 +290,7 @@ fn grid_image(
         .map(|n| wrap(n, DETAIL_PX, (width - 2 * PAD) as f64))
         .collect::<Result<Vec<_>, _>>()?
         .concat();
-    let legend_h = LEGEND_H[(kind == Kind::Heat) as usize];
+    let legend_h = LEGEND_H[(kind != Kind::Shaded) as usize];
     let footer_h = legend_h + notes.len() as u32 * NOTE_LINE_H;
     let height = 2 * PAD + HEADER_H + rows.len().max(1) as u32 * row_h + footer_h;
     let mut image = RgbImage::filled(width, height, [255; 3]);
@@ -316,11 +363,35 @@ fn grid_image(
                         Align::Center,
                     ));
                 }
-                Cell::Rendered { shaded, heat } => {
-                    image.paste(if kind == Kind::Shaded { shaded } else { heat }, x, top);
+                Cell::Rendered { shaded, heat, area, clipped } => {
+                    let picture = match kind {
+                        Kind::Shaded => shaded,
+                        Kind::Heat => heat,
+                        Kind::Area => area,
+                    };
+                    image.paste(picture, x, top);
+                    let mut marks = Vec::new();
+                    if *clipped {
+                        marks.push(("clipped: leaves the frame", FAILED_INK));
+                    }
+                    if case.is_some_and(|c| c.status.is_suspect()) {
+                        marks.push(("suspect", SUSPECT_INK));
+                    }
+                    if let Some((_, color)) = marks.first() {
+                        image.outline_rect(x + 2, top + 2, CELL_SIZE - 4, CELL_SIZE - 4, 3, *color);
+                    }
+                    for (i, (text, color)) in marks.iter().enumerate() {
+                        let at = (centre, (top + 28 + 24 * i as i64) as f64);
+                        labels.push(Label::new(*text, DETAIL_PX, *color, at, Align::Center));
+                    }
                     if let Some(case) = case {
                         let caption = (centre, (top + CELL_SIZE as i64 + 27) as f64);
-                        labels.push(error_caption(case.e_theta_deg, case.e_phi_deg, caption));
+                        labels.push(match kind {
+                            Kind::Area => area_caption(case.metric(Metric::EArea), caption),
+                            _ => {
+                                error_caption(case.metric(Metric::ETheta), case.metric(Metric::EPhi), caption)
+                            }
+                        });
                     }
                 }
             }
@@ -335,6 +406,7 @@ fn grid_image(
     match kind {
         Kind::Shaded => role_legend(&mut image, &mut labels, PAD as i64, footer),
         Kind::Heat => heat_legend(&mut image, &mut labels, PAD as i64, footer),
+        Kind::Area => area_legend(&mut image, &mut labels, PAD as i64, footer),
     }
     for (i, line) in notes.into_iter().enumerate() {
         let y = footer + (legend_h + (i as u32 + 1) * NOTE_LINE_H) as i64 - 8;
@@ -359,6 +431,12 @@ fn error_caption(e_theta: f64, e_phi: f64, at: (f64, f64)) -> Label {
     Label::rich(&spans, CAPTION_PX, INK, at, Align::Center)
 }
 
+/// "e_area x.xxx" centred at `(x, baseline)`.
+fn area_caption(e_area: f64, at: (f64, f64)) -> Label {
+    let value = if e_area.is_finite() { format!("e_area {e_area:.3}") } else { "e_area n/a".to_string() };
+    Label::new(value, CAPTION_PX, INK, at, Align::Center)
+}
+
 /// Swatches of the vertex roles, at `(x, y)` (top-left).
 fn role_legend(image: &mut RgbImage, labels: &mut Vec<Label>, x: i64, y: i64) {
     let mut left = x;
@@ -371,28 +449,62 @@ fn role_legend(image: &mut RgbImage, labels: &mut Vec<Label>, x: i64, y: i64) {
     }
 }
 
-/// The heat colour bar `0..HEAT_MAX_DEG` under its title, with ticks, at `(x, y)` (top-left).
-fn heat_legend(image: &mut RgbImage, labels: &mut Vec<Label>, x: i64, y: i64) {
+/// A colour bar under `title` at `(x, y)` (top-left): `color_at(t)` for `t` from 0 (left) to 1
+/// (right), and a tick with its label at each `(t, text)` of `ticks`.
+fn color_bar(
+    image: &mut RgbImage,
+    labels: &mut Vec<Label>,
+    (x, y): (i64, i64),
+    title: &str,
+    color_at: impl Fn(f64) -> [f64; 3],
+    ticks: &[(f64, String)],
+) {
     const BAR_W: u32 = 360;
     const BAR_H: u32 = 16;
-    let title = "Per-vertex RMS change of the corner angles (degrees), one scale for all cells";
     labels.push(Label::new(title, LEGEND_PX, INK, (x as f64, (y + 22) as f64), Align::Left));
     let bar_y = y + 32;
     for i in 0..BAR_W {
-        let degrees = HEAT_MAX_DEG * (i as f64 + 0.5) / BAR_W as f64;
-        let color = heat_color(degrees).map(|c| (255.0 * c).round() as u8);
+        let color = color_at((i as f64 + 0.5) / BAR_W as f64).map(|c| (255.0 * c).round() as u8);
         image.fill_rect(x + i as i64, bar_y, 1, BAR_H, color);
     }
-    let ticks = 5;
-    for t in 0..=ticks {
-        let tx = x + (t * (BAR_W - 1) / ticks) as i64;
+    for (t, text) in ticks {
+        let tx = x + (t * (BAR_W - 1) as f64).round() as i64;
         image.fill_rect(tx, bar_y + BAR_H as i64, 1, 5, INK);
-        let degrees = HEAT_MAX_DEG * t as f64 / ticks as f64;
-        // The top colour stands for everything above the scale.
-        let text = if t == ticks { format!("\u{2265}{degrees}\u{b0}") } else { format!("{degrees}\u{b0}") };
         let at = (tx as f64, (bar_y + BAR_H as i64 + 22) as f64);
-        labels.push(Label::new(text, TICK_PX, INK, at, Align::Center));
+        labels.push(Label::new(text.as_str(), TICK_PX, INK, at, Align::Center));
     }
+}
+
+/// The heat colour bar `0..HEAT_MAX_DEG` under its title, with ticks, at `(x, y)` (top-left).
+fn heat_legend(image: &mut RgbImage, labels: &mut Vec<Label>, x: i64, y: i64) {
+    let ticks: Vec<(f64, String)> = (0..=5)
+        .map(|t| {
+            let degrees = HEAT_MAX_DEG * t as f64 / 5.0;
+            // The top colour stands for everything above the scale.
+            let text = if t == 5 { format!("\u{2265}{degrees}\u{b0}") } else { format!("{degrees}\u{b0}") };
+            (t as f64 / 5.0, text)
+        })
+        .collect();
+    let title = "Per-vertex RMS change of the corner angles (degrees), one scale for all cells";
+    color_bar(image, labels, (x, y), title, |t| heat_color(t * HEAT_MAX_DEG), &ticks);
+}
+
+/// The diverging area colour bar `±AREA_MAX_LOG` under its title, ticks as area factors, at
+/// `(x, y)` (top-left).
+fn area_legend(image: &mut RgbImage, labels: &mut Vec<Label>, x: i64, y: i64) {
+    let ticks: Vec<(f64, String)> = (0..=4)
+        .map(|t| {
+            let factor = (AREA_MAX_LOG * (t as f64 / 2.0 - 1.0)).exp();
+            let text = match t {
+                0 => format!("\u{2264}\u{d7}{factor:.2}"),
+                4 => format!("\u{2265}\u{d7}{factor:.2}"),
+                _ => format!("\u{d7}{factor:.2}"),
+            };
+            (t as f64 / 4.0, text)
+        })
+        .collect();
+    let title = "Per-vertex area change A / A\u{2070} of the one-ring (log scale), one scale for all cells";
+    color_bar(image, labels, (x, y), title, |t| area_color((2.0 * t - 1.0) * AREA_MAX_LOG), &ticks);
 }
 
 /// `text` broken at spaces into lines at most `max_width` pixels wide at font size `size` (a word
@@ -467,31 +579,12 @@ mod tests {
     }
 
     fn case(scenario: &str, method: &str, status: &str, positions: Option<Vec<[f64; 3]>>) -> CaseResult {
-        CaseResult {
-            scenario: scenario.into(),
-            method: method.into(),
-            mesh_source: "procedural look-alike".into(),
-            vertices: 0,
-            faces: 0,
-            precompute_s: 0.0,
-            bind_s: 0.0,
-            median_iteration_ms: 0.0,
-            iterations: 1,
-            solve_s: 0.0,
-            total_s: 0.0,
-            converged: true,
-            e_theta_deg: 1.234,
-            e_phi_deg: f64::NAN,
-            handle_residual_over_diag: 0.0,
-            rms_to_arap_over_diag: None,
-            self_intersecting: None,
-            status: status.into(),
-            phase_timings: Vec::new(),
-            statistics: Vec::new(),
-            steps: Vec::new(),
-            trace: Vec::new(),
-            positions,
-        }
+        let mut c = CaseResult::empty(scenario, method, "procedural look-alike", 0, 0);
+        c.quality.set(Metric::ETheta, Some(1.234));
+        c.quality.set(Metric::EArea, Some(0.05));
+        c.status = status.parse().unwrap();
+        c.positions = positions;
+        c
     }
 
     /// Scenario `tiny`: `laplacian` bent, `odd/name` with a NaN vertex, `arap` failed; scenario
@@ -525,11 +618,14 @@ mod tests {
             "tiny-rest.png",
             "tiny-laplacian.png",
             "tiny-laplacian-heat.png",
+            "tiny-laplacian-area.png",
             "tiny-odd_name.png",
             "tiny-odd_name-heat.png",
+            "tiny-odd_name-area.png",
             "other-rest.png",
             "grid.png",
             "grid_heat.png",
+            "grid_area.png",
         ];
         let expected: Vec<PathBuf> = expected.iter().map(|f| Path::new("figures").join(f)).collect();
         assert_eq!(written, expected);
@@ -544,7 +640,7 @@ mod tests {
         assert_eq!(on_disk, names, "nothing else, no temporary files left");
         for path in &written {
             let image = decode(&dirs[0].path().join(path));
-            if !path.ends_with("grid.png") && !path.ends_with("grid_heat.png") {
+            if !path.file_name().unwrap().to_string_lossy().starts_with("grid") {
                 assert_eq!(image.dimensions(), (CELL_SIZE, CELL_SIZE), "{}", path.display());
             }
         }
@@ -597,11 +693,55 @@ mod tests {
     }
 
     #[test]
-    fn no_results_still_give_both_grids() {
+    fn no_results_still_give_every_grid() {
         let dir = tempfile::tempdir().unwrap();
         let written = write_figures(dir.path(), &[], &[scenario("unused")]).unwrap();
-        assert_eq!(written, [Path::new("figures/grid.png"), Path::new("figures/grid_heat.png")]);
+        assert_eq!(
+            written,
+            [
+                Path::new("figures/grid.png"),
+                Path::new("figures/grid_heat.png"),
+                Path::new("figures/grid_area.png")
+            ]
+        );
         assert!(written.iter().all(|p| dir.path().join(p).is_file()));
+    }
+
+    #[test]
+    fn a_runaway_result_leaves_the_rest_picture_unchanged_and_is_marked_clipped() {
+        let (results, scenarios) = inputs();
+        let rest = scenarios[0].mesh.positions();
+        let diagonal = scenarios[0].mesh.bbox_diagonal();
+        // 30 diagonals away, as the diverged `hirm` of issue 14 was.
+        let far: Vec<[f64; 3]> =
+            rest.iter().map(|p| [p[0] + 30.0 * diagonal, p[1], p[2] - 5.0 * diagonal]).collect();
+        let mut with_runaway = results.clone();
+        with_runaway.push(case("tiny", "hirm", "suspect: leaves its frame", Some(far)));
+        let dirs = [tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap()];
+        write_figures(dirs[0].path(), &results, &scenarios).unwrap();
+        let written = write_figures(dirs[1].path(), &with_runaway, &scenarios).unwrap();
+        for name in ["tiny-rest.png", "tiny-laplacian.png", "tiny-laplacian-heat.png"] {
+            let bytes = |d: &tempfile::TempDir| std::fs::read(d.path().join("figures").join(name)).unwrap();
+            assert!(
+                bytes(&dirs[0]) == bytes(&dirs[1]),
+                "{name} changed when a runaway result joined its row"
+            );
+        }
+        // The runaway result is entirely outside the frame: its picture is blank.
+        assert!(written.contains(&Path::new("figures").join("tiny-hirm.png")));
+        let runaway = decode(&dirs[1].path().join("figures/tiny-hirm.png"));
+        assert!(runaway.pixels().all(|p| p.0 == [255; 3]), "clipped away");
+        // Its grid cell carries the red frame of a clipped cell; the same cell without it does not exist.
+        let camera = Camera::for_shapes([rest], 1.0);
+        let targets = frame_targets(&scenarios[0]);
+        assert!(!targets.is_empty());
+        let framed = Camera::for_shapes(std::iter::once(rest).chain(targets.iter().map(Vec::as_slice)), 1.0);
+        assert!(leaves_frame(&framed, &with_runaway.last().unwrap().positions.clone().unwrap()));
+        assert!(!leaves_frame(&framed, rest));
+        assert!(!leaves_frame(&camera, rest));
+        let grid = decode(&dirs[1].path().join("figures/grid.png"));
+        let red = grid.pixels().filter(|p| p.0 == FAILED_INK).count();
+        assert!(red > 4 * (CELL_SIZE as usize - 4), "the clipped cell is outlined: {red} red pixels");
     }
 
     #[test]

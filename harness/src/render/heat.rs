@@ -1,4 +1,5 @@
-//! The per-vertex angle error of a result (where `E_theta` comes from) and its colour scale.
+//! The per-vertex angle error of a result (where `E_theta` comes from), the per-vertex area
+//! distortion (where `e_area` comes from), and their colour scales.
 
 use meshes::geometry::{corner_angles, triangle_area};
 
@@ -27,9 +28,14 @@ pub fn heat_color(degrees: f64) -> [f64; 3] {
     if degrees.is_nan() {
         return NO_VALUE;
     }
-    let t = (degrees / HEAT_MAX_DEG).clamp(0.0, 1.0);
-    let i = HEAT_STOPS.iter().position(|(s, _)| *s >= t).unwrap_or(HEAT_STOPS.len() - 1).max(1);
-    let ((s0, c0), (s1, c1)) = (HEAT_STOPS[i - 1], HEAT_STOPS[i]);
+    interpolate(&HEAT_STOPS, degrees / HEAT_MAX_DEG)
+}
+
+/// The colour at `t` of the piecewise-linear scale through `stops` (ascending), clamped to its ends.
+fn interpolate(stops: &[(f64, [f64; 3])], t: f64) -> [f64; 3] {
+    let t = t.clamp(stops[0].0, stops[stops.len() - 1].0);
+    let i = stops.iter().position(|(s, _)| *s >= t).unwrap_or(stops.len() - 1).max(1);
+    let ((s0, c0), (s1, c1)) = (stops[i - 1], stops[i]);
     let u = ((t - s0) / (s1 - s0)).clamp(0.0, 1.0);
     std::array::from_fn(|k| c0[k] + u * (c1[k] - c0[k]))
 }
@@ -70,9 +76,67 @@ pub fn vertex_angle_errors(rest: &[[f64; 3]], result: &[[f64; 3]], triangles: &[
         .collect()
 }
 
+/// End of the area-distortion colour scale, as `|ln(A / A⁰)|`: `ln 2`, an area halved or doubled.
+/// The same for every image.
+pub const AREA_MAX_LOG: f64 = std::f64::consts::LN_2;
+
+/// Stops of the diverging area scale at `-1, -0.5, 0, 0.5, 1` of [`AREA_MAX_LOG`]: shrinking dark
+/// to light blue, unchanged light grey (not white, so it stays visible on the background), growing
+/// light to dark red (ColorBrewer's RdBu).
+const AREA_STOPS: [(f64, [f64; 3]); 5] = [
+    (-1.0, [0.129, 0.400, 0.675]),
+    (-0.5, [0.573, 0.773, 0.871]),
+    (0.0, [0.86, 0.86, 0.86]),
+    (0.5, [0.957, 0.647, 0.510]),
+    (1.0, [0.698, 0.094, 0.169]),
+];
+
+/// Colour (sRGB in `[0, 1]`) of the log area ratio `ln(A / A⁰)` on the fixed scale
+/// `±`[`AREA_MAX_LOG`], clamped at both ends; grey for NaN.
+pub fn area_color(log_ratio: f64) -> [f64; 3] {
+    if log_ratio.is_nan() {
+        return NO_VALUE;
+    }
+    interpolate(&AREA_STOPS, log_ratio / AREA_MAX_LOG)
+}
+
+/// `#V` per-vertex area distortion of the `#V x 3` `result` against the `#V x 3` `rest` positions:
+/// `ln(sum of the adjacent face areas / the same sum at rest)`, the one-ring's log area ratio
+/// (`2 ln s` for a uniform scaling by `s`, 0 for rigid motions). A vertex whose one-ring has no rest
+/// area, or a non-finite result area, gets NaN; all NaN (no panic) for mismatched input.
+pub fn vertex_area_distortion(rest: &[[f64; 3]], result: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<f64> {
+    let n = rest.len();
+    if result.len() != n || triangles.iter().flatten().any(|&i| i as usize >= n) {
+        return vec![f64::NAN; n.max(result.len())];
+    }
+    let mut sums = vec![[0.0f64; 2]; n];
+    for t in triangles {
+        let (a0, a) = (triangle_area(rest, t), triangle_area(result, t));
+        for &v in t {
+            sums[v as usize][0] += a0;
+            sums[v as usize][1] += a;
+        }
+    }
+    sums.iter().map(|[a0, a]| if *a0 > 0.0 && a.is_finite() { (a / a0).ln() } else { f64::NAN }).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn area_distortion_is_the_log_ratio_and_the_scale_diverges() {
+        let rest = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let doubled: Vec<[f64; 3]> = rest.iter().map(|p| p.map(|c| c * 2f64.sqrt())).collect();
+        let d = vertex_area_distortion(&rest, &doubled, &[[0, 1, 2]]);
+        assert!(d.iter().all(|v| (v - 2f64.ln()).abs() < 1e-12), "{d:?}");
+        let near = |a: [f64; 3], b: [f64; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 1e-12);
+        assert!(near(area_color(AREA_MAX_LOG), AREA_STOPS[4].1));
+        assert!(near(area_color(-10.0), AREA_STOPS[0].1));
+        assert!(near(area_color(0.0), AREA_STOPS[2].1));
+        assert_eq!(area_color(f64::NAN), NO_VALUE);
+        assert!(vertex_area_distortion(&rest, &rest[..2], &[[0, 1, 2]]).iter().all(|v| v.is_nan()));
+    }
     use meshes::shapes::{generate, ShapeKind};
     use meshes::AffineTransform;
 

@@ -5,7 +5,7 @@ use meshes::vector::{add, cross, dot, normalize_or_zero, scale, sub};
 
 use super::camera::Camera;
 use super::canvas::RgbImage;
-use super::heat::heat_color;
+use super::heat::{area_color, heat_color};
 use super::raster::rasterize;
 
 /// Samples per pixel along each axis: images are rasterized this many times larger and averaged
@@ -55,6 +55,8 @@ pub enum Paint<'a> {
     /// `#V` values in degrees, interpolated across faces and mapped by [`heat_color`]; faces with a
     /// NaN corner take the nearest corner's value, and NaN (no value) is drawn grey.
     Heat(&'a [f64]),
+    /// `#V` log area ratios, interpolated like [`Paint::Heat`] and mapped by [`area_color`].
+    Area(&'a [f64]),
 }
 
 /// Render the `#F x 3` `triangles` of the `#V x 3` `positions` seen by `camera` into one
@@ -128,7 +130,7 @@ fn surface_color(paint: &Paint, tri: [u32; 3], w: [f32; 3]) -> ([f64; 3], f64) {
             let role = roles.get(tri[nearest] as usize).copied().unwrap_or(VertexRole::Free);
             (role.color(), AMBIENT_ROLES)
         }
-        Paint::Heat(values) => {
+        Paint::Heat(values) | Paint::Area(values) => {
             let value = |k: usize| values.get(tri[k] as usize).copied().unwrap_or(f64::NAN);
             let corners = [value(0), value(1), value(2)];
             let v = if corners.iter().all(|v| v.is_finite()) {
@@ -136,7 +138,8 @@ fn surface_color(paint: &Paint, tri: [u32; 3], w: [f32; 3]) -> ([f64; 3], f64) {
             } else {
                 corners[nearest]
             };
-            (heat_color(v), AMBIENT_HEAT)
+            let color = if matches!(paint, Paint::Area(_)) { area_color(v) } else { heat_color(v) };
+            (color, AMBIENT_HEAT)
         }
     }
 }

@@ -1,0 +1,230 @@
+//! The verdict on a case: `ok`, `suspect: <reasons>` (it finished, but its shape is broken in a way
+//! a measure sees), or `failed: <error>` (no result). The thresholds are data
+//! (`configs/verdicts.toml`), each with the reason for its value written there.
+//!
+//! A suspect case is still a result: the run's exit code stays 0 for it, and it is drawn and
+//! reported like any other, with its reasons. Not converging is its own column, not a reason.
+
+use std::fmt;
+use std::path::Path;
+use std::str::FromStr;
+
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+use crate::error::HarnessError;
+use crate::metrics::{Metric, Quality};
+
+/// When a finished case is suspect (`configs/verdicts.toml`).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VerdictRules {
+    /// Largest `folds` (fraction of interior edges) that is still `ok`.
+    pub max_folds: f64,
+    /// Largest handle residual (over the rest diagonal) that is still `ok`.
+    pub max_handle_residual_over_diag: f64,
+    /// A vertex may move at most the largest handle displacement plus this many rest diagonals.
+    pub frame_margin_diagonals: f64,
+}
+
+impl VerdictRules {
+    /// Read and check `path`.
+    pub fn load(path: &Path) -> Result<Self, HarnessError> {
+        let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
+        let text = std::fs::read_to_string(path)
+            .map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
+        let rules: VerdictRules = toml::from_str(&text).map_err(|e| config(e.to_string()))?;
+        for (name, value) in [
+            ("max_folds", rules.max_folds),
+            ("max_handle_residual_over_diag", rules.max_handle_residual_over_diag),
+            ("frame_margin_diagonals", rules.frame_margin_diagonals),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(config(format!("`{name}` must be a finite number >= 0, not {value}")));
+            }
+        }
+        Ok(rules)
+    }
+
+    /// The reasons a finished case with `quality` is suspect (empty: `ok`).
+    /// `largest_move` is the largest distance of any result vertex from its rest position and
+    /// `largest_handle_move` the largest distance of a handle target from its vertex's rest position
+    /// (over every edit step), both over the rest diagonal: a result is judged on itself, not against
+    /// another method's.
+    pub fn reasons(&self, quality: &Quality, largest_move: f64, largest_handle_move: f64) -> Vec<String> {
+        let mut reasons = Vec::new();
+        let non_finite: Vec<&str> = quality.non_finite().map(Metric::key).collect();
+        if !non_finite.is_empty() || !largest_move.is_finite() {
+            let mut what = non_finite;
+            if !largest_move.is_finite() {
+                what.push("positions");
+            }
+            reasons.push(format!("non-finite {}", what.join(", ")));
+        }
+        if let Some(f) = quality.get(Metric::Folds).filter(|f| *f > self.max_folds) {
+            reasons.push(format!("folds: {:.3}% of interior edges turned by more than 90°", 100.0 * f));
+        }
+        if let Some(r) =
+            quality.get(Metric::HandleResidual).filter(|r| *r > self.max_handle_residual_over_diag)
+        {
+            reasons.push(format!(
+                "misses its handles: residual {r:.2e} of the diagonal (> {:.0e})",
+                self.max_handle_residual_over_diag
+            ));
+        }
+        let allowed = largest_handle_move + self.frame_margin_diagonals;
+        if largest_move > allowed {
+            reasons.push(format!(
+                "leaves its frame: a vertex moved {largest_move:.2} diagonals (handles at most {largest_handle_move:.2})"
+            ));
+        }
+        reasons
+    }
+}
+
+/// The verdict on one case.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Status {
+    Ok,
+    /// Finished, with these reasons to distrust the shape.
+    Suspect(Vec<String>),
+    /// No result: the method's error.
+    Failed(String),
+}
+
+impl Status {
+    pub fn is_ok(&self) -> bool {
+        matches!(self, Status::Ok)
+    }
+
+    pub fn is_suspect(&self) -> bool {
+        matches!(self, Status::Suspect(_))
+    }
+
+    pub fn is_failed(&self) -> bool {
+        matches!(self, Status::Failed(_))
+    }
+
+    /// `ok`, `suspect` or `failed`, without the reasons.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Suspect(_) => "suspect",
+            Status::Failed(_) => "failed",
+        }
+    }
+
+    /// `Ok` for no reasons, else `Suspect`.
+    pub fn from_reasons(reasons: Vec<String>) -> Status {
+        if reasons.is_empty() {
+            Status::Ok
+        } else {
+            Status::Suspect(reasons)
+        }
+    }
+}
+
+impl fmt::Display for Status {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Status::Ok => f.write_str("ok"),
+            Status::Suspect(reasons) => write!(f, "suspect: {}", reasons.join("; ")),
+            Status::Failed(error) => write!(f, "failed: {error}"),
+        }
+    }
+}
+
+impl FromStr for Status {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s == "ok" {
+            Ok(Status::Ok)
+        } else if let Some(reasons) = s.strip_prefix("suspect: ") {
+            Ok(Status::Suspect(reasons.split("; ").map(String::from).collect()))
+        } else if let Some(error) = s.strip_prefix("failed: ") {
+            Ok(Status::Failed(error.to_string()))
+        } else {
+            Err(format!("a status is `ok`, `suspect: <reasons>` or `failed: <error>`, not `{s}`"))
+        }
+    }
+}
+
+impl Serialize for Status {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(self)
+    }
+}
+
+impl<'de> Deserialize<'de> for Status {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        String::deserialize(deserializer)?.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rules() -> VerdictRules {
+        VerdictRules { max_folds: 0.0, max_handle_residual_over_diag: 1e-3, frame_margin_diagonals: 1.0 }
+    }
+
+    fn quality(folds: f64, residual: f64) -> Quality {
+        let mut q = Quality::default();
+        q.set(Metric::ETheta, Some(1.0));
+        q.set(Metric::Folds, Some(folds));
+        q.set(Metric::HandleResidual, Some(residual));
+        q
+    }
+
+    #[test]
+    fn each_reason_is_found_and_a_clean_case_is_ok() {
+        let r = rules();
+        assert!(r.reasons(&quality(0.0, 1e-9), 0.3, 0.2).is_empty());
+        let folded = r.reasons(&quality(1e-4, 1e-9), 0.3, 0.2);
+        assert!(folded.len() == 1 && folded[0].starts_with("folds: 0.010%"), "{folded:?}");
+        let missed = r.reasons(&quality(0.0, 2e-3), 0.3, 0.2);
+        assert!(missed.len() == 1 && missed[0].starts_with("misses its handles"), "{missed:?}");
+        // 0.2 of handle motion + 1 diagonal of margin: 1.19 is inside, 1.21 outside.
+        assert!(r.reasons(&quality(0.0, 0.0), 1.19, 0.2).is_empty());
+        let left = r.reasons(&quality(0.0, 0.0), 1.21, 0.2);
+        assert!(left.len() == 1 && left[0].starts_with("leaves its frame"), "{left:?}");
+        let mut q = quality(0.0, 0.0);
+        q.set(Metric::EArea, Some(f64::INFINITY));
+        let nan = r.reasons(&q, f64::NAN, 0.2);
+        assert_eq!(nan, vec!["non-finite e_area, positions".to_string()]);
+    }
+
+    #[test]
+    fn status_round_trips_through_its_text() {
+        for s in [
+            Status::Ok,
+            Status::Suspect(vec!["folds: 1%".into(), "misses its handles".into()]),
+            Status::Failed("solver: not positive definite".into()),
+        ] {
+            assert_eq!(s.to_string().parse::<Status>().unwrap(), s);
+            let json = serde_json::to_string(&s).unwrap();
+            assert_eq!(serde_json::from_str::<Status>(&json).unwrap(), s);
+        }
+        assert!("fine".parse::<Status>().is_err());
+    }
+
+    #[test]
+    fn the_committed_rules_load_and_bad_values_are_named() {
+        let committed = crate::suite::workspace_root().join("configs/verdicts.toml");
+        let r = VerdictRules::load(&committed).unwrap();
+        assert_eq!(r.max_folds, 0.0, "any fold is suspect (issue 14)");
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("verdicts.toml");
+        std::fs::write(
+            &path,
+            "max_folds = -1\nmax_handle_residual_over_diag = 1e-3\nframe_margin_diagonals = 1\n",
+        )
+        .unwrap();
+        let e = VerdictRules::load(&path).unwrap_err().to_string();
+        assert!(e.contains("verdicts.toml") && e.contains("max_folds"), "{e}");
+        std::fs::write(&path, "max_fold = 0\n").unwrap();
+        let e = VerdictRules::load(&path).unwrap_err().to_string();
+        assert!(e.contains("unknown field"), "{e}");
+    }
+}
