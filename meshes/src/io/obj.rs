@@ -7,9 +7,12 @@
 //! far, as the format specifies.
 //!
 //! This is a hand-written parser rather than `tobj` because the benchmark needs the file's vertices
-//! exactly as written: `tobj` (without its `use_f64` feature) rounds positions to `f32`, renumbers
-//! vertices in order of first use and per object/group (which would invalidate a per-vertex `.sel`
-//! selection and disconnect groups), and drops unreferenced vertices.
+//! exactly as written, and per-vertex files (`.sel`, libigl `.dmat` selections) index them in file
+//! order. With `LoadOptions { triangulate: true, single_index: false, .. }`, tobj 4 emits one model
+//! per `o` object and per `g` group, each with its own positions numbered in order of first use by
+//! that model's faces: vertices are reordered, vertices shared across groups are duplicated (the
+//! groups come apart) and vertices no face uses are dropped; without its `use_f64` feature it also
+//! rounds positions to `f32`. `tests/obj_tobj.rs` shows the reordering on a five-vertex file.
 
 use std::io::Write;
 use std::path::Path;
