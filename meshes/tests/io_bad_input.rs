@@ -198,9 +198,19 @@ fn obj_errors_name_line_or_element() {
         MeshError::Syntax { line: 1, .. }
     ));
 
-    let c = file("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1/1 2/2 3/3 4/4\n");
-    let e = unwrap_in_file(read_obj(&c.path), &c.path, &["face 1", "4 corners"]);
-    assert!(matches!(e, MeshError::NotATriangle { face: 1, corners: 4 }), "{e:?}");
+    // Quads are triangulated now (see obj_polygons_are_fan_triangulated); a 2-corner face cannot be.
+    let c = file("segment.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1/1 2/2\n");
+    let e = unwrap_in_file(read_obj(&c.path), &c.path, &["face 1", "2 corners", "triangulated"]);
+    assert!(matches!(e, MeshError::Untriangulable { face: 1, corners: 2, .. }), "{e:?}");
+
+    let c = file("pinched.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2 3 3 4\n");
+    let e = unwrap_in_file(read_obj(&c.path), &c.path, &["face 1", "repeats vertex 2"]);
+    assert!(matches!(e, MeshError::Untriangulable { face: 1, corners: 5, .. }), "{e:?}");
+
+    // The face number is the file's, not the triangle's: face 1 comes after a quad (two triangles).
+    let c = file("range_after_quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2 9\n");
+    let e = unwrap_in_file(read_obj(&c.path), &c.path, &["face 1", "index 8"]);
+    assert!(matches!(e, MeshError::IndexOutOfRange { face: 1, index: 8, n_vertices: 4 }), "{e:?}");
 
     let c = file("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
     let e = unwrap_in_file(read_obj(&c.path), &c.path, &["line 4", "face 0", "index 0"]);

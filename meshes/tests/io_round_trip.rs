@@ -81,6 +81,16 @@ fn obj_reader_handles_slashes_relative_indices_and_ignored_statements() {
 }
 
 #[test]
+fn obj_polygons_are_fan_triangulated() {
+    // A quad, a pentagon with corners given out of order and a triangle; vertex 5 defined after use.
+    let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3 4\nf 2/1 5/1 6/1 7/1 3/1\n\
+                v 2 1 0\nv 1.5 1.5 0\nf 4 3 7\n";
+    let mesh = meshes::io::parse_obj(text).unwrap();
+    assert_eq!(mesh.n_vertices(), 7);
+    assert_eq!(mesh.triangles(), &[[0, 1, 2], [0, 2, 3], [1, 4, 5], [1, 5, 6], [1, 6, 2], [3, 2, 6]]);
+}
+
+#[test]
 fn off_reader_accepts_comments_blank_lines_counts_on_header_and_extra_columns() {
     let text = "# leading comment\n\nOFF 4 2 0 # counts on the header line\n\
                 0 0 0 255 0 0 255\n  1 0 0\n\n# between vertices\n0 1 0 # trailing\n1 1 0\r\n\

@@ -20,6 +20,7 @@
 pub mod gltf;
 pub mod obj;
 pub mod off;
+pub mod polygon;
 pub mod survey;
 
 pub use self::gltf::{encode_glb, read_gltf, write_glb};
