@@ -385,8 +385,9 @@ fn transform_with_bad_number_or_not_affine() {
 
 #[test]
 fn unknown_or_missing_extension() {
-    let c = file("mesh.ply", "ply\n");
-    let e = unwrap_in_file(read_mesh(&c.path), &c.path, &["'.ply'", ".off"]);
+    // .ply is a mesh format now; .stl is not
+    let c = file("mesh.stl", "solid x\n");
+    let e = unwrap_in_file(read_mesh(&c.path), &c.path, &["'.stl'", ".off", ".ply"]);
     assert!(matches!(e, MeshError::Invalid(_)), "{e:?}");
     let c = file("mesh", "OFF\n");
     let e = unwrap_in_file(read_mesh(&c.path), &c.path, &["no extension"]);
@@ -398,7 +399,7 @@ fn missing_files_are_io_not_found_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let is_not_found =
         |e: &MeshError| matches!(e, MeshError::Io(io) if io.kind() == std::io::ErrorKind::NotFound);
-    for name in ["gone.off", "gone.obj", "gone.glb", "gone.gltf"] {
+    for name in ["gone.off", "gone.obj", "gone.ply", "gone.glb", "gone.gltf"] {
         let path = dir.path().join(name);
         let e = unwrap_in_file(read_mesh(&path), &path, &[]);
         assert!(is_not_found(&e), "{name}: {e:?}");

@@ -56,7 +56,7 @@ fn obj_round_trip_is_exact() {
 fn write_mesh_and_read_mesh_dispatch_on_extension() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = awkward_mesh();
-    for name in ["a.off", "b.OBJ", "c.Off"] {
+    for name in ["a.off", "b.OBJ", "c.Off", "f.ply"] {
         let path = dir.path().join(name);
         write_mesh(&path, &mesh).unwrap();
         assert_bitwise_equal(&read_mesh(&path).unwrap(), &mesh);
@@ -288,7 +288,7 @@ fn write_into_missing_directory_fails_and_creates_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("no-such-dir");
     let mesh = awkward_mesh();
-    for name in ["m.off", "m.obj", "m.glb"] {
+    for name in ["m.off", "m.obj", "m.ply", "m.glb"] {
         let path = missing.join(name);
         let err = write_mesh(&path, &mesh).unwrap_err();
         match &err {

@@ -54,11 +54,7 @@ impl Polygons {
 fn push_fan(triangles: &mut Vec<[u32; 3]>, face: usize, corners: &[u32]) -> Result<()> {
     let k = corners.len();
     if k < 3 {
-        return Err(MeshError::Untriangulable {
-            face,
-            corners: k,
-            reason: format!("has {k} corners, at least 3 are needed"),
-        });
+        return Err(MeshError::Untriangulable { face, corners: k, reason: "at least 3 are needed".into() });
     }
     let c0 = corners[0];
     for (i, pair) in corners[1..].windows(2).enumerate() {
