@@ -3,7 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use meshes::io::{read_gltf, read_mesh, read_obj, read_off, read_selection, read_transform};
+use meshes::io::{
+    read_dmat, read_dmat_column, read_gltf, read_index_list, read_mesh, read_obj, read_off, read_selection,
+    read_transform,
+};
 use meshes::MeshError;
 
 struct Case {
@@ -334,6 +337,61 @@ fn selection_with_non_integer_names_line() {
     let c = file("neg.sel", "0\n-1\n");
     let e = unwrap_in_file(read_selection(&c.path, 2), &c.path, &["line 2", "-1"]);
     assert!(matches!(e, MeshError::Syntax { line: 2, .. }), "{e:?}");
+}
+
+// ---- .dmat ----
+
+#[test]
+fn dmat_errors_name_the_file_and_line() {
+    let c = file("header.dmat", "1\n0\n");
+    let e = unwrap_in_file(read_dmat(&c.path), &c.path, &["line 1", "'#columns #rows'", "'1'"]);
+    assert!(matches!(e, MeshError::Syntax { line: 1, .. }), "{e:?}");
+    let c = file("neg.dmat", "1 -3\n0\n");
+    assert!(matches!(
+        unwrap_in_file(read_dmat(&c.path), &c.path, &["line 1"]),
+        MeshError::Syntax { line: 1, .. }
+    ));
+
+    let c = file("word.dmat", "1 3\n0\n1\ntwo\n");
+    let e = unwrap_in_file(read_dmat(&c.path), &c.path, &["line 4", "row 2", "'two'", "not a number"]);
+    assert!(matches!(e, MeshError::Syntax { line: 4, .. }), "{e:?}");
+    let e = unwrap_in_file(read_dmat_column(&c.path, 3), &c.path, &["line 4", "'two'", "integer"]);
+    assert!(matches!(e, MeshError::Syntax { line: 4, .. }), "{e:?}");
+
+    let c = file("few.dmat", "1 4\n0\n1\n");
+    let e = unwrap_in_file(read_dmat(&c.path), &c.path, &["4 values", "found 2"]);
+    assert!(matches!(e, MeshError::Truncated { .. }), "{e:?}");
+    let c = file("many.dmat", "1 2\n0\n1\n\n2\n");
+    let e = unwrap_in_file(read_dmat(&c.path), &c.path, &["line 5", "'2'", "2 values"]);
+    assert!(matches!(e, MeshError::Syntax { line: 5, .. }), "{e:?}");
+
+    let c = file("sel.dmat", "1 3\n-1\n0\n1\n");
+    let e = unwrap_in_file(read_dmat_column(&c.path, 4), &c.path, &["sel.dmat", "3 entries", "4 vertices"]);
+    assert!(matches!(e, MeshError::LengthMismatch { got: 3, expected: 4, .. }), "{e:?}");
+    let c = file("wide.dmat", "2 2\n0 0\n0 0\n");
+    let e = unwrap_in_file(read_dmat_column(&c.path, 2), &c.path, &["one column", "2 columns"]);
+    assert!(matches!(e, MeshError::Invalid(_)), "{e:?}");
+
+    let c = file("empty.dmat", "");
+    assert!(matches!(unwrap_in_file(read_dmat(&c.path), &c.path, &["header"]), MeshError::Truncated { .. }));
+    let c =
+        file("binary.dmat", b"0 0\n1 2\n\x00\x00\x00\x00\x00\x00\xf0\xbf\x00\x00\x00\x00\x00\x00\xf0\xff");
+    let e = unwrap_in_file(read_dmat(&c.path), &c.path, &["binary .dmat", "not supported"]);
+    assert!(matches!(e, MeshError::Format(_)), "{e:?}");
+}
+
+// ---- vertex-id lists ----
+
+#[test]
+fn index_list_errors_name_the_file_and_line() {
+    let c = file("ids.txt", "# handle\n1 2\n3 x4\n");
+    let e = unwrap_in_file(read_index_list(&c.path), &c.path, &["ids.txt", "line 3", "entry 3", "'x4'"]);
+    assert!(matches!(e, MeshError::Syntax { line: 3, .. }), "{e:?}");
+    let c = file("neg.txt", "1\n-2\n");
+    let e = unwrap_in_file(read_index_list(&c.path), &c.path, &["line 2", "'-2'", "non-negative"]);
+    assert!(matches!(e, MeshError::Syntax { line: 2, .. }), "{e:?}");
+    let c = file("ok.txt", "5 # trailing\n\n0\n");
+    assert_eq!(read_index_list(&c.path).unwrap(), vec![5, 0]);
 }
 
 // ---- .def ----

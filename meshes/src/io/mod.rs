@@ -17,7 +17,9 @@
 //! - every writer goes through [`atomic_write`]: a failed write never leaves a partial file behind and
 //!   never clobbers an existing file.
 
+pub mod dmat;
 pub mod gltf;
+pub mod index_list;
 pub mod obj;
 pub mod off;
 pub mod ply;
@@ -25,6 +27,8 @@ pub mod polygon;
 pub mod survey;
 
 pub use self::gltf::{encode_glb, read_gltf, write_glb};
+pub use dmat::{read_dmat, read_dmat_column, DenseMatrix};
+pub use index_list::read_index_list;
 pub use obj::{parse_obj, read_obj, write_obj};
 pub use off::{parse_off, read_off, write_off};
 pub use ply::{parse_ply, read_ply, write_ply};
