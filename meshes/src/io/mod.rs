@@ -2,11 +2,20 @@
 //!
 //! | format | read | write | module |
 //! |---|---|---|---|
-//! | OFF (`.off`) | [`read_off`] | [`write_off`] | [`off`] |
-//! | Wavefront OBJ (`.obj`) | [`read_obj`] | [`write_obj`] | [`obj`] |
-//! | glTF 2.0 (`.gltf`, `.glb`) | [`read_gltf`] | [`write_glb`] (binary only) | [`gltf`] |
+//! | OFF (`.off`), triangles only | [`read_off`] | [`write_off`] | [`off`] |
+//! | Wavefront OBJ (`.obj`), polygons fan-triangulated | [`read_obj`] | [`write_obj`] | [`obj`] |
+//! | Stanford PLY (`.ply`), ASCII and binary LE/BE, polygons fan-triangulated | [`read_ply`] | [`write_ply`] (binary LE, doubles) | [`ply`] |
+//! | glTF 2.0 (`.gltf`, `.glb`) | [`read_gltf`] | [`write_glb`] (binary only, `f32` positions) | [`gltf`] |
 //! | survey selection (`.sel`) | [`read_selection`] | [`write_selection`] | [`survey`] |
 //! | survey handle transform (`.def`) | [`read_transform`] | [`write_transform`] | [`survey`] |
+//! | libigl dense matrix (`.dmat`, text), e.g. a per-vertex selection column | [`read_dmat`], [`read_dmat_column`] | — | [`dmat`] |
+//! | vertex-id list (0-based ids, `#` comments) | [`read_index_list`] | — | [`index_list`] |
+//!
+//! [`read_mesh`] and [`write_mesh`] choose among the mesh formats by extension. Faces of more than 3
+//! corners (OBJ, PLY) are fan-triangulated from their first corner ([`polygon`]), which is correct for
+//! convex polygons and those star-shaped from corner 0; errors then still name the file's face.
+//! Readers keep vertices that no face uses; [`crate::clean::drop_unreferenced`] removes them and maps
+//! results back.
 //!
 //! Conventions shared by every reader and writer:
 //! - every error is wrapped in [`MeshError::InFile`], so its message starts with the file's path;
