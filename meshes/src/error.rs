@@ -33,6 +33,10 @@ pub enum MeshError {
     /// A face is not a triangle.
     #[error("face {face}: has {corners} corners; only triangles are supported")]
     NotATriangle { face: usize, corners: usize },
+    /// A polygon face (OBJ, PLY) cannot be fan-triangulated: it has fewer than 3 corners, or one of
+    /// its fan triangles would use a vertex twice. `face` is 0-based, in file order.
+    #[error("face {face}: a polygon of {corners} corners that cannot be triangulated: {reason}")]
+    Untriangulable { face: usize, corners: usize, reason: String },
     /// A face uses the same vertex twice.
     #[error("face {face}: repeats vertex {vertex}")]
     RepeatedVertex { face: usize, vertex: u32 },

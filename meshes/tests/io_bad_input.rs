@@ -3,7 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use meshes::io::{read_gltf, read_mesh, read_obj, read_off, read_selection, read_transform};
+use meshes::io::{
+    read_dmat, read_dmat_column, read_gltf, read_index_list, read_mesh, read_obj, read_off, read_selection,
+    read_transform,
+};
 use meshes::MeshError;
 
 struct Case {
@@ -198,9 +201,19 @@ fn obj_errors_name_line_or_element() {
         MeshError::Syntax { line: 1, .. }
     ));
 
-    let c = file("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1/1 2/2 3/3 4/4\n");
-    let e = unwrap_in_file(read_obj(&c.path), &c.path, &["face 1", "4 corners"]);
-    assert!(matches!(e, MeshError::NotATriangle { face: 1, corners: 4 }), "{e:?}");
+    // Quads are triangulated now (see obj_polygons_are_fan_triangulated); a 2-corner face cannot be.
+    let c = file("segment.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1/1 2/2\n");
+    let e = unwrap_in_file(read_obj(&c.path), &c.path, &["face 1", "2 corners", "triangulated"]);
+    assert!(matches!(e, MeshError::Untriangulable { face: 1, corners: 2, .. }), "{e:?}");
+
+    let c = file("pinched.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2 3 3 4\n");
+    let e = unwrap_in_file(read_obj(&c.path), &c.path, &["face 1", "repeats vertex 2"]);
+    assert!(matches!(e, MeshError::Untriangulable { face: 1, corners: 5, .. }), "{e:?}");
+
+    // The face number is the file's, not the triangle's: face 1 comes after a quad (two triangles).
+    let c = file("range_after_quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2 9\n");
+    let e = unwrap_in_file(read_obj(&c.path), &c.path, &["face 1", "index 8"]);
+    assert!(matches!(e, MeshError::IndexOutOfRange { face: 1, index: 8, n_vertices: 4 }), "{e:?}");
 
     let c = file("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
     let e = unwrap_in_file(read_obj(&c.path), &c.path, &["line 4", "face 0", "index 0"]);
@@ -326,6 +339,61 @@ fn selection_with_non_integer_names_line() {
     assert!(matches!(e, MeshError::Syntax { line: 2, .. }), "{e:?}");
 }
 
+// ---- .dmat ----
+
+#[test]
+fn dmat_errors_name_the_file_and_line() {
+    let c = file("header.dmat", "1\n0\n");
+    let e = unwrap_in_file(read_dmat(&c.path), &c.path, &["line 1", "'#columns #rows'", "'1'"]);
+    assert!(matches!(e, MeshError::Syntax { line: 1, .. }), "{e:?}");
+    let c = file("neg.dmat", "1 -3\n0\n");
+    assert!(matches!(
+        unwrap_in_file(read_dmat(&c.path), &c.path, &["line 1"]),
+        MeshError::Syntax { line: 1, .. }
+    ));
+
+    let c = file("word.dmat", "1 3\n0\n1\ntwo\n");
+    let e = unwrap_in_file(read_dmat(&c.path), &c.path, &["line 4", "row 2", "'two'", "not a number"]);
+    assert!(matches!(e, MeshError::Syntax { line: 4, .. }), "{e:?}");
+    let e = unwrap_in_file(read_dmat_column(&c.path, 3), &c.path, &["line 4", "'two'", "integer"]);
+    assert!(matches!(e, MeshError::Syntax { line: 4, .. }), "{e:?}");
+
+    let c = file("few.dmat", "1 4\n0\n1\n");
+    let e = unwrap_in_file(read_dmat(&c.path), &c.path, &["4 values", "found 2"]);
+    assert!(matches!(e, MeshError::Truncated { .. }), "{e:?}");
+    let c = file("many.dmat", "1 2\n0\n1\n\n2\n");
+    let e = unwrap_in_file(read_dmat(&c.path), &c.path, &["line 5", "'2'", "2 values"]);
+    assert!(matches!(e, MeshError::Syntax { line: 5, .. }), "{e:?}");
+
+    let c = file("sel.dmat", "1 3\n-1\n0\n1\n");
+    let e = unwrap_in_file(read_dmat_column(&c.path, 4), &c.path, &["sel.dmat", "3 entries", "4 vertices"]);
+    assert!(matches!(e, MeshError::LengthMismatch { got: 3, expected: 4, .. }), "{e:?}");
+    let c = file("wide.dmat", "2 2\n0 0\n0 0\n");
+    let e = unwrap_in_file(read_dmat_column(&c.path, 2), &c.path, &["one column", "2 columns"]);
+    assert!(matches!(e, MeshError::Invalid(_)), "{e:?}");
+
+    let c = file("empty.dmat", "");
+    assert!(matches!(unwrap_in_file(read_dmat(&c.path), &c.path, &["header"]), MeshError::Truncated { .. }));
+    let c =
+        file("binary.dmat", b"0 0\n1 2\n\x00\x00\x00\x00\x00\x00\xf0\xbf\x00\x00\x00\x00\x00\x00\xf0\xff");
+    let e = unwrap_in_file(read_dmat(&c.path), &c.path, &["binary .dmat", "not supported"]);
+    assert!(matches!(e, MeshError::Format(_)), "{e:?}");
+}
+
+// ---- vertex-id lists ----
+
+#[test]
+fn index_list_errors_name_the_file_and_line() {
+    let c = file("ids.txt", "# handle\n1 2\n3 x4\n");
+    let e = unwrap_in_file(read_index_list(&c.path), &c.path, &["ids.txt", "line 3", "entry 3", "'x4'"]);
+    assert!(matches!(e, MeshError::Syntax { line: 3, .. }), "{e:?}");
+    let c = file("neg.txt", "1\n-2\n");
+    let e = unwrap_in_file(read_index_list(&c.path), &c.path, &["line 2", "'-2'", "non-negative"]);
+    assert!(matches!(e, MeshError::Syntax { line: 2, .. }), "{e:?}");
+    let c = file("ok.txt", "5 # trailing\n\n0\n");
+    assert_eq!(read_index_list(&c.path).unwrap(), vec![5, 0]);
+}
+
 // ---- .def ----
 
 const ROW: &str = "1 0 0 0\n";
@@ -375,8 +443,9 @@ fn transform_with_bad_number_or_not_affine() {
 
 #[test]
 fn unknown_or_missing_extension() {
-    let c = file("mesh.ply", "ply\n");
-    let e = unwrap_in_file(read_mesh(&c.path), &c.path, &["'.ply'", ".off"]);
+    // .ply is a mesh format now; .stl is not
+    let c = file("mesh.stl", "solid x\n");
+    let e = unwrap_in_file(read_mesh(&c.path), &c.path, &["'.stl'", ".off", ".ply"]);
     assert!(matches!(e, MeshError::Invalid(_)), "{e:?}");
     let c = file("mesh", "OFF\n");
     let e = unwrap_in_file(read_mesh(&c.path), &c.path, &["no extension"]);
@@ -388,7 +457,7 @@ fn missing_files_are_io_not_found_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let is_not_found =
         |e: &MeshError| matches!(e, MeshError::Io(io) if io.kind() == std::io::ErrorKind::NotFound);
-    for name in ["gone.off", "gone.obj", "gone.glb", "gone.gltf"] {
+    for name in ["gone.off", "gone.obj", "gone.ply", "gone.glb", "gone.gltf"] {
         let path = dir.path().join(name);
         let e = unwrap_in_file(read_mesh(&path), &path, &[]);
         assert!(is_not_found(&e), "{name}: {e:?}");

@@ -56,7 +56,7 @@ fn obj_round_trip_is_exact() {
 fn write_mesh_and_read_mesh_dispatch_on_extension() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = awkward_mesh();
-    for name in ["a.off", "b.OBJ", "c.Off"] {
+    for name in ["a.off", "b.OBJ", "c.Off", "f.ply"] {
         let path = dir.path().join(name);
         write_mesh(&path, &mesh).unwrap();
         assert_bitwise_equal(&read_mesh(&path).unwrap(), &mesh);
@@ -78,6 +78,16 @@ fn obj_reader_handles_slashes_relative_indices_and_ignored_statements() {
     let mesh = meshes::io::parse_obj(text).unwrap();
     assert_eq!(mesh.n_vertices(), 4);
     assert_eq!(mesh.triangles(), &[[0, 1, 2], [1, 3, 2]]);
+}
+
+#[test]
+fn obj_polygons_are_fan_triangulated() {
+    // A quad, a pentagon with corners given out of order and a triangle; vertex 5 defined after use.
+    let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3 4\nf 2/1 5/1 6/1 7/1 3/1\n\
+                v 2 1 0\nv 1.5 1.5 0\nf 4 3 7\n";
+    let mesh = meshes::io::parse_obj(text).unwrap();
+    assert_eq!(mesh.n_vertices(), 7);
+    assert_eq!(mesh.triangles(), &[[0, 1, 2], [0, 2, 3], [1, 4, 5], [1, 5, 6], [1, 6, 2], [3, 2, 6]]);
 }
 
 #[test]
@@ -278,7 +288,7 @@ fn write_into_missing_directory_fails_and_creates_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("no-such-dir");
     let mesh = awkward_mesh();
-    for name in ["m.off", "m.obj", "m.glb"] {
+    for name in ["m.off", "m.obj", "m.ply", "m.glb"] {
         let path = missing.join(name);
         let err = write_mesh(&path, &mesh).unwrap_err();
         match &err {

@@ -7,7 +7,7 @@
 //! `f64`). Without any scene, every mesh is read untransformed. Primitives do not share vertices with
 //! each other (glTF has no such concept), so a mesh split into several primitives (typically one per
 //! material) has duplicated vertices along the splits. Point and line primitives carry no surface and
-//! are skipped; strips and fans are rejected rather than converted, like polygons in OFF and OBJ.
+//! are skipped; strips and fans are rejected rather than converted, like polygons in OFF.
 //! Sparse accessors are not supported. Textures and images are never loaded.
 
 use std::path::Path;

@@ -2,11 +2,20 @@
 //!
 //! | format | read | write | module |
 //! |---|---|---|---|
-//! | OFF (`.off`) | [`read_off`] | [`write_off`] | [`off`] |
-//! | Wavefront OBJ (`.obj`) | [`read_obj`] | [`write_obj`] | [`obj`] |
-//! | glTF 2.0 (`.gltf`, `.glb`) | [`read_gltf`] | [`write_glb`] (binary only) | [`gltf`] |
+//! | OFF (`.off`), triangles only | [`read_off`] | [`write_off`] | [`off`] |
+//! | Wavefront OBJ (`.obj`), polygons fan-triangulated | [`read_obj`] | [`write_obj`] | [`obj`] |
+//! | Stanford PLY (`.ply`), ASCII and binary LE/BE, polygons fan-triangulated | [`read_ply`] | [`write_ply`] (binary LE, doubles) | [`ply`] |
+//! | glTF 2.0 (`.gltf`, `.glb`) | [`read_gltf`] | [`write_glb`] (binary only, `f32` positions) | [`gltf`] |
 //! | survey selection (`.sel`) | [`read_selection`] | [`write_selection`] | [`survey`] |
 //! | survey handle transform (`.def`) | [`read_transform`] | [`write_transform`] | [`survey`] |
+//! | libigl dense matrix (`.dmat`, text), e.g. a per-vertex selection column | [`read_dmat`], [`read_dmat_column`] | — | [`dmat`] |
+//! | vertex-id list (0-based ids, `#` comments) | [`read_index_list`] | — | [`index_list`] |
+//!
+//! [`read_mesh`] and [`write_mesh`] choose among the mesh formats by extension. Faces of more than 3
+//! corners (OBJ, PLY) are fan-triangulated from their first corner ([`polygon`]), which is correct for
+//! convex polygons and those star-shaped from corner 0; errors then still name the file's face.
+//! Readers keep vertices that no face uses; [`crate::clean::drop_unreferenced`] removes them and maps
+//! results back.
 //!
 //! Conventions shared by every reader and writer:
 //! - every error is wrapped in [`MeshError::InFile`], so its message starts with the file's path;
@@ -17,14 +26,21 @@
 //! - every writer goes through [`atomic_write`]: a failed write never leaves a partial file behind and
 //!   never clobbers an existing file.
 
+pub mod dmat;
 pub mod gltf;
+pub mod index_list;
 pub mod obj;
 pub mod off;
+pub mod ply;
+pub mod polygon;
 pub mod survey;
 
 pub use self::gltf::{encode_glb, read_gltf, write_glb};
+pub use dmat::{read_dmat, read_dmat_column, DenseMatrix};
+pub use index_list::read_index_list;
 pub use obj::{parse_obj, read_obj, write_obj};
 pub use off::{parse_off, read_off, write_off};
+pub use ply::{parse_ply, read_ply, write_ply};
 pub use survey::{read_selection, read_transform, write_selection, write_transform};
 
 use std::ffi::OsString;
@@ -44,6 +60,8 @@ pub enum MeshFormat {
     Off,
     /// Wavefront OBJ, `.obj`.
     Obj,
+    /// Stanford PLY (ASCII or binary), `.ply`.
+    Ply,
     /// glTF 2.0 JSON with external or embedded buffers, `.gltf`.
     Gltf,
     /// glTF 2.0 binary container, `.glb`.
@@ -51,7 +69,7 @@ pub enum MeshFormat {
 }
 
 impl MeshFormat {
-    /// The format of `path` from its extension (case-insensitive: `off`, `obj`, `gltf`, `glb`).
+    /// The format of `path` from its extension (case-insensitive: `off`, `obj`, `ply`, `gltf`, `glb`).
     /// Fails with [`MeshError::Invalid`] naming the file for any other or a missing extension.
     pub fn from_path(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
@@ -59,14 +77,15 @@ impl MeshFormat {
         match ext.as_deref() {
             Some("off") => Ok(MeshFormat::Off),
             Some("obj") => Ok(MeshFormat::Obj),
+            Some("ply") => Ok(MeshFormat::Ply),
             Some("gltf") => Ok(MeshFormat::Gltf),
             Some("glb") => Ok(MeshFormat::Glb),
             Some(other) => Err(MeshError::Invalid(format!(
-                "unknown mesh file extension '.{other}' (supported: .off, .obj, .gltf, .glb)"
+                "unknown mesh file extension '.{other}' (supported: .off, .obj, .ply, .gltf, .glb)"
             ))
             .in_file(path)),
             None => Err(MeshError::Invalid(
-                "mesh file has no extension (supported: .off, .obj, .gltf, .glb)".into(),
+                "mesh file has no extension (supported: .off, .obj, .ply, .gltf, .glb)".into(),
             )
             .in_file(path)),
         }
@@ -76,24 +95,27 @@ impl MeshFormat {
 /// Read a triangle mesh (`#V x 3` positions, `#F x 3` triangles) from `path`, choosing the reader
 /// from the extension (see [`MeshFormat::from_path`]).
 ///
-/// Errors name the file; see [`read_off`], [`read_obj`] and [`read_gltf`] for what each format accepts.
+/// Errors name the file; see [`read_off`], [`read_obj`], [`read_ply`] and [`read_gltf`] for what each
+/// format accepts.
 pub fn read_mesh(path: impl AsRef<Path>) -> Result<TriMesh> {
     let path = path.as_ref();
     match MeshFormat::from_path(path)? {
         MeshFormat::Off => read_off(path),
         MeshFormat::Obj => read_obj(path),
+        MeshFormat::Ply => read_ply(path),
         MeshFormat::Gltf | MeshFormat::Glb => read_gltf(path),
     }
 }
 
 /// Write `mesh` (`#V x 3` positions, `#F x 3` triangles) to `path`, choosing the writer from the
-/// extension: `.off`, `.obj` or `.glb` (without colors). Writing `.gltf` is not supported (a `.glb`
+/// extension: `.off`, `.obj`, `.ply` (binary, doubles) or `.glb` (without colors). Writing `.gltf` is not supported (a `.glb`
 /// holds the same content in one file). Atomic, see [`atomic_write`].
 pub fn write_mesh(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
     let path = path.as_ref();
     match MeshFormat::from_path(path)? {
         MeshFormat::Off => write_off(path, mesh),
         MeshFormat::Obj => write_obj(path, mesh),
+        MeshFormat::Ply => write_ply(path, mesh),
         MeshFormat::Glb => write_glb(path, mesh, None),
         MeshFormat::Gltf => Err(MeshError::Invalid(
             "writing .gltf is not supported; write a .glb (binary glTF) instead".into(),

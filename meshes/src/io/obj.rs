@@ -3,29 +3,38 @@
 //! Reads the `v` (position) and `f` (face) statements and ignores everything else (`vt`, `vn`, groups,
 //! objects, materials, smoothing groups, lines, points, free-form geometry). Face corners may be written
 //! `v`, `v/vt`, `v//vn` or `v/vt/vn`; only the position index is used, so texture and normal seams do
-//! not split vertices. Indices are 1-based; negative indices count back from the last vertex defined so
-//! far, as the format specifies.
+//! not split vertices, nor do `o`/`g` groups. Indices are 1-based; negative indices count back from the
+//! last vertex defined so far, as the format specifies. Faces of more than 3 corners are
+//! fan-triangulated from their first corner (see [`super::polygon`]: correct for convex polygons and
+//! those star-shaped from corner 0).
 //!
 //! This is a hand-written parser rather than `tobj` because the benchmark needs the file's vertices
-//! exactly as written: `tobj` (without its `use_f64` feature) rounds positions to `f32`, renumbers
-//! vertices in order of first use and per object/group (which would invalidate a per-vertex `.sel`
-//! selection and disconnect groups), and drops unreferenced vertices.
+//! exactly as written, and per-vertex files (`.sel`, libigl `.dmat` selections) index them in file
+//! order. With `LoadOptions { triangulate: true, single_index: false, .. }`, tobj 4 emits one model
+//! per `o` object and per `g` group, each with its own positions numbered in order of first use by
+//! that model's faces: vertices are reordered, vertices shared across groups are duplicated (the
+//! groups come apart) and vertices no face uses are dropped; without its `use_f64` feature it also
+//! rounds positions to `f32`. `tests/obj_tobj.rs` shows the reordering on a five-vertex file.
 
 use std::io::Write;
 use std::path::Path;
 
+use super::polygon::Polygons;
 use super::{atomic_write, data_lines, read_text, syntax, RoundTrip};
 use crate::error::{MeshError, Result};
 use crate::mesh::TriMesh;
 
 /// Read the OBJ file `path` into a mesh of `#V x 3` positions (every `v`, in file order, including
-/// vertices no face uses) and `#F x 3` triangles (every `f`, in file order, made 0-based).
+/// vertices no face uses) and `#T x 3` triangles (every `f` in file order, made 0-based, a face of
+/// `k > 3` corners giving `k - 2` consecutive fan triangles).
 ///
-/// Errors (all wrapped in [`MeshError::InFile`]): [`MeshError::Syntax`] with the line for a malformed
-/// number, too few coordinates, a rational vertex (`w != 1`), an index of 0 or a relative index before
-/// the first vertex; [`MeshError::NotATriangle`] for a face with other than 3 corners (no
-/// triangulation); and the validation errors of [`TriMesh::new`] (non-finite coordinate naming the
-/// vertex, out-of-range index naming the face).
+/// Errors (all wrapped in [`MeshError::InFile`]; faces are numbered 0-based in file order, not by
+/// triangle): [`MeshError::Syntax`] with the line for a malformed number, too few coordinates, a
+/// rational vertex (`w != 1`), an index of 0 or a relative index before the first vertex;
+/// [`MeshError::IndexOutOfRange`] naming the face for an index past the last vertex;
+/// [`MeshError::Untriangulable`] naming the face for fewer than 3 corners or a repeated corner that
+/// puts one vertex twice into a fan triangle; and [`MeshError::NonFiniteCoordinate`] naming the
+/// vertex.
 pub fn read_obj(path: impl AsRef<Path>) -> Result<TriMesh> {
     let path = path.as_ref();
     read_text(path).and_then(|text| parse_obj(&text)).map_err(|e| e.in_file(path))
@@ -35,7 +44,7 @@ pub fn read_obj(path: impl AsRef<Path>) -> Result<TriMesh> {
 /// a file name.
 pub fn parse_obj(text: &str) -> Result<TriMesh> {
     let mut positions: Vec<[f64; 3]> = Vec::new();
-    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let mut faces = Polygons::new();
     for (line, content) in data_lines(text) {
         let mut tokens = content.split_ascii_whitespace();
         match tokens.next() {
@@ -62,21 +71,16 @@ pub fn parse_obj(text: &str) -> Result<TriMesh> {
                 positions.push(p);
             }
             Some("f") => {
-                let f = triangles.len();
-                let corners: Vec<&str> = tokens.collect();
-                let [a, b, c] = corners[..] else {
-                    return Err(MeshError::NotATriangle { face: f, corners: corners.len() });
-                };
+                let f = faces.len();
                 let n = positions.len();
-                triangles.push([
-                    parse_corner(a, f, n, line)?,
-                    parse_corner(b, f, n, line)?,
-                    parse_corner(c, f, n, line)?,
-                ]);
+                let corners = tokens.map(|t| parse_corner(t, f, n, line)).collect::<Result<Vec<u32>>>()?;
+                faces.push(corners);
             }
             _ => {}
         }
     }
+    // Range checks wait until every `v` is read: a face may name a vertex defined after it.
+    let triangles = faces.triangulate(positions.len())?;
     TriMesh::new(positions, triangles)
 }
 
