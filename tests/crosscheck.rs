@@ -488,7 +488,8 @@ fn peers_area_distortion_and_volume_change_match_libigl_and_pymeshlab() {
         let e_area_err = (ours_e_area - theirs_e_area).abs() / theirs_e_area;
 
         let measures = |path: &std::path::Path| -> serde_json::Value {
-            serde_json::from_str(&peers_reference(&py, &["geometric_measures", path.to_str().unwrap()])).unwrap()
+            serde_json::from_str(&peers_reference(&py, &["geometric_measures", path.to_str().unwrap()]))
+                .unwrap()
         };
         let (m0, m) = (measures(&rest_path), measures(&result_path));
         let ours_area: f64 = meshes::geometry::face_areas(&result, mesh.triangles()).iter().sum();
@@ -507,10 +508,15 @@ fn peers_area_distortion_and_volume_change_match_libigl_and_pymeshlab() {
             (Some(ours), Some(v0), Some(v)) => {
                 let theirs = (v - v0) / v0;
                 println!("{name}: volume_change difference to pymeshlab {:.1e}", (ours - theirs).abs());
-                assert!((ours - theirs).abs() <= 1e-9, "{name}: volume_change {ours} against pymeshlab's {theirs}");
+                assert!(
+                    (ours - theirs).abs() <= 1e-9,
+                    "{name}: volume_change {ours} against pymeshlab's {theirs}"
+                );
             }
             (None, None, None) => assert!(!topology.is_closed(), "{name}"),
-            other => panic!("{name}: closed mesh by our topology {} but volumes {other:?}", topology.is_closed()),
+            other => {
+                panic!("{name}: closed mesh by our topology {} but volumes {other:?}", topology.is_closed())
+            }
         }
     }
 }

@@ -9,6 +9,7 @@ use crate::case::CaseResult;
 use crate::metrics::METRICS;
 use crate::regression::{BaselineKind, GateOutcome};
 use crate::scenario::load_specs;
+use crate::shard::Shard;
 use crate::suite::{self, SuiteOptions, SURVEY_DIR_ENV};
 use crate::{html, peers, plots, regression, render, report};
 use anyhow::Context;
@@ -38,13 +39,29 @@ enum Command {
         /// Skip the regression check.
         #[arg(long)]
         no_check: bool,
+        /// Run part K of N (a job array's task; see the README): a deterministic share of the
+        /// scenarios, balanced by their estimated cost. Writes a partial report (results.json and
+        /// the result meshes) for `merge`; no plots, figures or regression check.
+        #[arg(long, value_name = "K/N")]
+        shard: Option<Shard>,
+    },
+    /// Combine the partial reports of `all --shard K/N` (one directory each, K = 1..N) into the
+    /// report one run would have written, ending with the regression check.
+    Merge {
+        /// The partial report directories.
+        #[arg(required = true)]
+        partials: Vec<PathBuf>,
+        #[command(flatten)]
+        common: Common,
+        #[command(flatten)]
+        gate: Gate,
     },
     /// Run chosen methods on one scenario and print the results (writes reports/ like `all`).
     Run {
         /// Method name (repeatable; see `list`).
         #[arg(long = "method", required = true)]
         methods: Vec<String>,
-        /// Scenario name (see `list`).
+        /// Scenario name (see `list`), or the path of a scenario file.
         #[arg(long)]
         scenario: String,
         #[command(flatten)]
@@ -123,9 +140,13 @@ struct Common {
     /// procedural look-alikes are used, and every report says so.
     #[arg(long, env = SURVEY_DIR_ENV)]
     survey_dir: Option<PathBuf>,
-    /// Configuration directory (methods.toml, scenarios/).
+    /// Configuration directory (methods.toml, verdicts.toml, scenarios/).
     #[arg(long)]
     configs: Option<PathBuf>,
+    /// Scenario directory [default: scenarios/ in the configuration directory]; e.g.
+    /// configs/real-meshes for the real-mesh suite.
+    #[arg(long)]
+    scenarios: Option<PathBuf>,
     /// Output directory.
     #[arg(long)]
     reports: Option<PathBuf>,
@@ -139,6 +160,7 @@ impl Common {
         let root = suite::workspace_root();
         SuiteOptions {
             configs_dir: self.configs.clone().unwrap_or_else(|| root.join("configs")),
+            scenarios_dir: self.scenarios.clone(),
             reports_dir: self.reports.clone().unwrap_or_else(|| root.join("reports")),
             survey_dir: self.survey_dir.clone(),
             scenarios,
@@ -164,29 +186,29 @@ where
 {
     let cli = Cli::parse_from(args);
     match cli.command {
-        Command::All { common, peers, gate, no_check } => {
+        Command::All { common, peers, gate, no_check, shard } => {
             let options = common.options(Vec::new(), Vec::new());
-            let default_configs = suite::workspace_root().join("configs");
-            let same = |a: &std::path::Path, b: &std::path::Path| {
-                a.canonicalize().ok().zip(b.canonicalize().ok()).is_some_and(|(a, b)| a == b)
-            };
-            let gate = if no_check {
-                Err("--no-check".to_string())
-            } else if !same(&options.configs_dir, &default_configs) {
-                Err(format!("the baseline covers the scenarios of {}", default_configs.display()))
-            } else {
-                Ok(gate)
-            };
-            execute(&options, peers.python()?, gate)
+            if let Some(shard) = shard {
+                return run_shard(&options, shard);
+            }
+            let gate = if no_check { Err("--no-check".to_string()) } else { standard_suite(&options, gate) };
+            let run = suite::run(&options).context("preparing the run")?;
+            publish(&options, run, peers.python()?, gate)
         }
-        Command::Run { methods, scenario, common, peers } => execute(
-            &common.options(vec![scenario], methods),
-            peers.python()?,
-            Err("`run` covers one scenario".to_string()),
-        ),
+        Command::Merge { partials, common, gate } => {
+            let options = common.options(Vec::new(), Vec::new());
+            let run = suite::merge(&options, &partials).context("merging partial reports")?;
+            let gate = standard_suite(&options, gate);
+            publish(&options, run, None, gate)
+        }
+        Command::Run { methods, scenario, common, peers } => {
+            let options = common.options(vec![scenario], methods);
+            let run = suite::run(&options).context("preparing the run")?;
+            publish(&options, run, peers.python()?, Err("`run` covers one scenario".to_string()))
+        }
         Command::Check { common, gate } => {
             let dir = common.options(Vec::new(), Vec::new()).reports_dir;
-            let (results, _) = regression::read_results(&dir.join("results.json"))?;
+            let results = report::read_results(&dir.join("results.json"))?.cases;
             let path = gate.path(&results);
             if !path.is_file() {
                 anyhow::bail!("{}: no such baseline", path.display());
@@ -198,7 +220,7 @@ where
         }
         Command::Baseline { common, gate } => {
             let dir = common.options(Vec::new(), Vec::new()).reports_dir;
-            let (results, _) = regression::read_results(&dir.join("results.json"))?;
+            let results = report::read_results(&dir.join("results.json"))?.cases;
             let baseline = regression::baseline_from(&results);
             let path = gate.path(&results);
             regression::write_baseline(&path, &baseline)?;
@@ -244,14 +266,59 @@ fn print_findings(findings: &[regression::Finding], baseline: &std::path::Path) 
     }
 }
 
-/// Run the suite, check the results with open3d when `peer_python` is given, write every report,
-/// and compare with the baseline `gate` names (or say why not).
-fn execute(
+/// The gate of a run with `options`: the committed baselines cover the default configuration
+/// (`configs/` and its scenarios); any other run is compared only with a baseline named on purpose.
+fn standard_suite(options: &SuiteOptions, gate: Gate) -> Result<Gate, String> {
+    let default_configs = suite::workspace_root().join("configs");
+    let same = |a: &std::path::Path, b: &std::path::Path| {
+        a.canonicalize().ok().zip(b.canonicalize().ok()).is_some_and(|(a, b)| a == b)
+    };
+    if gate.baseline.is_some() {
+        Ok(gate)
+    } else if !same(&options.configs_dir, &default_configs) || options.scenarios_dir.is_some() {
+        Err(format!(
+            "the committed baselines cover the scenarios of {} (name one with --baseline)",
+            default_configs.display()
+        ))
+    } else {
+        Ok(gate)
+    }
+}
+
+/// Run part `shard` of the suite and write its partial report.
+fn run_shard(options: &SuiteOptions, shard: Shard) -> anyhow::Result<ExitCode> {
+    let run = suite::run_shard(options, shard).context("preparing the run")?;
+    for note in &run.notes {
+        eprintln!("note: {note}");
+    }
+    let dir = &options.reports_dir;
+    report::write_partial(dir, &run.results, &run.scenarios, &run.data_source, shard)
+        .context("writing the partial report")?;
+    print_table(&run.results);
+    println!(
+        "shard {shard}: {} scenario(s), {} case(s); partial report in {} (combine the N parts with `harness merge`)",
+        run.scenarios.len(),
+        run.results.len(),
+        dir.display()
+    );
+    if run.results.iter().any(|r| r.status.is_failed()) {
+        eprintln!("error: some case(s) failed (see the status column)");
+        return Ok(ExitCode::from(EXIT_CASE_FAILED));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Check the results of `run` with open3d when `peer_python` is given, write every report, and
+/// compare with the baseline `gate` names (or say why not); print the table and pick the exit code.
+fn publish(
     options: &SuiteOptions,
+    mut run: suite::SuiteRun,
     peer_python: Option<PathBuf>,
     gate: Result<Gate, String>,
 ) -> anyhow::Result<ExitCode> {
-    let mut run = suite::run(options).context("preparing the run")?;
+    for note in &run.notes {
+        eprintln!("note: {note}");
+    }
     if let Some(python) = peer_python {
         let answers = peers::self_intersections(&python, &run.results, &run.scenarios)
             .context("self-intersection check (open3d)")?;
@@ -269,8 +336,11 @@ fn execute(
         Err(reason) => GateOutcome::NotChecked(reason),
     };
     let table1 = report::render_table1(&run.results);
-    html::write_index(dir, &html::render_index(&run.results, &run.data_source, &images, &table1, &outcome))
-        .context("writing index.html")?;
+    html::write_index(
+        dir,
+        &html::render_index(&run.results, &run.data_source, &images, &table1, &outcome, &run.notes),
+    )
+    .context("writing index.html")?;
 
     println!("data: {}", run.data_source);
     print_table(&run.results);

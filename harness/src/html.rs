@@ -33,6 +33,7 @@ pub fn render_index(
     images: &[PathBuf],
     table1_markdown: &str,
     gate: &GateOutcome,
+    notes: &[String],
 ) -> String {
     let mut page = String::new();
     page.push_str(concat!(
@@ -75,6 +76,13 @@ pub fn render_index(
          <code>failed</code> (red) when the method gave no result.</p>\n",
     );
 
+    if !notes.is_empty() {
+        page.push_str("<h2 id=\"notes\">Notes on the inputs</h2>\n<ul>\n");
+        for n in notes {
+            let _ = writeln!(page, "<li>{}</li>", escape(n));
+        }
+        page.push_str("</ul>\n");
+    }
     page.push_str("<h2 id=\"verdict\">Quality regression gate</h2>\n");
     match gate {
         GateOutcome::Checked { baseline, findings } => {

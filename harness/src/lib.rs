@@ -14,6 +14,7 @@ pub mod regression;
 pub mod render;
 pub mod report;
 pub mod scenario;
+pub mod shard;
 pub mod suite;
 pub mod verdict;
 

@@ -269,21 +269,6 @@ pub fn write_baseline(path: &Path, baseline: &Baseline) -> Result<(), HarnessErr
     Ok(())
 }
 
-/// The cases and data source of a `results.json` written by a run.
-pub fn read_results(path: &Path) -> Result<(Vec<CaseResult>, String), HarnessError> {
-    #[derive(Deserialize)]
-    struct Stored {
-        data_source: String,
-        cases: Vec<CaseResult>,
-    }
-    let text = std::fs::read(path).map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
-    let stored: Stored = serde_json::from_slice(&text).map_err(|e| HarnessError::Config {
-        path: path.to_path_buf(),
-        message: format!("not a results.json of this harness: {e}"),
-    })?;
-    Ok((stored.cases, stored.data_source))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

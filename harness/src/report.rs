@@ -11,6 +11,7 @@ use crate::case::CaseResult;
 use crate::error::HarnessError;
 use crate::metrics::METRICS;
 use crate::scenario::LoadedScenario;
+use crate::shard::Shard;
 
 /// The CSV columns before the metrics, with units in the names.
 const CASE_COLUMNS: &[&str] = &[
@@ -46,8 +47,37 @@ pub fn csv_columns() -> Vec<&'static str> {
 struct JsonReport<'a> {
     generator: &'static str,
     data_source: &'a str,
+    /// `K/N` in a partial report of `all --shard K/N`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    shard: Option<String>,
     units: &'static str,
     cases: &'a [CaseResult],
+}
+
+/// A `results.json` read back.
+pub struct StoredReport {
+    pub cases: Vec<CaseResult>,
+    pub data_source: String,
+    /// The part, for a partial report.
+    pub shard: Option<Shard>,
+}
+
+/// Read a `results.json` written by a run (or a shard of one).
+pub fn read_results(path: &Path) -> Result<StoredReport, HarnessError> {
+    #[derive(serde::Deserialize)]
+    struct Stored {
+        data_source: String,
+        #[serde(default)]
+        shard: Option<String>,
+        cases: Vec<CaseResult>,
+    }
+    let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
+    let text = std::fs::read(path).map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
+    let stored: Stored = serde_json::from_slice(&text)
+        .map_err(|e| config(format!("not a results.json of this harness: {e}")))?;
+    let shard =
+        stored.shard.map(|s| s.parse::<Shard>()).transpose().map_err(|e| config(format!("shard: {e}")))?;
+    Ok(StoredReport { cases: stored.cases, data_source: stored.data_source, shard })
 }
 
 /// A CSV number: empty for NaN (a missing value), else 7 significant digits.
@@ -91,11 +121,17 @@ pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
     w.into_inner().map_err(|e| HarnessError::Report(format!("CSV: {e}")))
 }
 
-/// `results.json` contents: every CSV column plus method phase timings and per-iteration traces.
-pub fn render_json(results: &[CaseResult], data_source: &str) -> Result<Vec<u8>, HarnessError> {
+/// `results.json` contents: every CSV column plus method phase timings and per-iteration traces
+/// (and the part, for a partial report).
+pub fn render_json(
+    results: &[CaseResult],
+    data_source: &str,
+    shard: Option<Shard>,
+) -> Result<Vec<u8>, HarnessError> {
     let report = JsonReport {
         generator: concat!("deformbench harness ", env!("CARGO_PKG_VERSION")),
         data_source,
+        shard: shard.map(|s| s.to_string()),
         units: "times in seconds (median_iteration_ms in milliseconds); angles in degrees; *_over_diag relative to the rest bounding-box diagonal; e_area, e_length RMS log ratios; volume_change and folds fractions",
         cases: results,
     };
@@ -240,7 +276,35 @@ pub fn write_reports(
     data_source: &str,
 ) -> Result<(), HarnessError> {
     let csv = render_csv(results)?;
-    let json = render_json(results, data_source)?;
+    let json = render_json(results, data_source, None)?;
+    write_meshes(dir, results, scenarios)?;
+    write_bytes(&dir.join("convergence.csv"), &render_convergence(results)?)?;
+    write_bytes(&dir.join("handle_updates.csv"), &render_handle_updates(results)?)?;
+    write_bytes(&dir.join("table1.md"), render_table1(results).as_bytes())?;
+    write_bytes(&dir.join("results.json"), &json)?;
+    write_bytes(&dir.join("results.csv"), &csv)?;
+    Ok(())
+}
+
+/// `results.json` with `shard` and the result meshes under `dir`: what `merge` needs of one part.
+pub fn write_partial(
+    dir: &Path,
+    results: &[CaseResult],
+    scenarios: &[LoadedScenario],
+    data_source: &str,
+    shard: Shard,
+) -> Result<(), HarnessError> {
+    let json = render_json(results, data_source, Some(shard))?;
+    write_meshes(dir, results, scenarios)?;
+    write_bytes(&dir.join("results.json"), &json)
+}
+
+/// `meshes/<scenario>-<method>.{off,glb}` of every case with a result, in the input's vertex order.
+fn write_meshes(
+    dir: &Path,
+    results: &[CaseResult],
+    scenarios: &[LoadedScenario],
+) -> Result<(), HarnessError> {
     let mesh_dir = dir.join("meshes");
     std::fs::create_dir_all(&mesh_dir).map_err(|error| HarnessError::Io { path: mesh_dir.clone(), error })?;
     for r in results {
@@ -249,16 +313,12 @@ pub fn write_reports(
         else {
             continue;
         };
-        let mesh = scenario.mesh.with_positions(positions.clone())?;
+        // In the input file's vertex order, so per-vertex data of the input still applies.
+        let mesh = scenario.in_input_order(positions)?;
         let stem = format!("{}-{}", r.scenario, r.method);
         meshes::io::write_off(mesh_dir.join(format!("{stem}.off")), &mesh)?;
         meshes::io::write_glb(mesh_dir.join(format!("{stem}.glb")), &mesh, None)?;
     }
-    write_bytes(&dir.join("convergence.csv"), &render_convergence(results)?)?;
-    write_bytes(&dir.join("handle_updates.csv"), &render_handle_updates(results)?)?;
-    write_bytes(&dir.join("table1.md"), render_table1(results).as_bytes())?;
-    write_bytes(&dir.join("results.json"), &json)?;
-    write_bytes(&dir.join("results.csv"), &csv)?;
     Ok(())
 }
 

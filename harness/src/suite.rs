@@ -9,7 +9,8 @@ use crate::case::{run_case, CaseResult, Reference};
 use crate::config::MethodParams;
 use crate::error::HarnessError;
 use crate::metrics::RestGeometry;
-use crate::scenario::{load_specs, DataSource, LoadedScenario};
+use crate::scenario::{load_spec, load_specs, DataSource, LoadedScenario, ScenarioSpec, FILE_SOURCE};
+use crate::shard::{assign, estimated_cost, Shard};
 use crate::verdict::VerdictRules;
 
 /// The method every other is compared with (`rms_to_arap_over_diag`, `max_to_arap_over_diag`).
@@ -22,9 +23,11 @@ pub const SURVEY_DIR_ENV: &str = "DEFORM_SURVEY_DIR";
 #[derive(Clone, Debug)]
 pub struct SuiteOptions {
     pub configs_dir: PathBuf,
+    /// The scenario files (default: `configs_dir/scenarios`).
+    pub scenarios_dir: Option<PathBuf>,
     pub reports_dir: PathBuf,
     pub survey_dir: Option<PathBuf>,
-    /// Restrict to these scenarios (empty: all).
+    /// Restrict to these scenarios (empty: all): names, or paths of scenario files.
     pub scenarios: Vec<String>,
     /// Restrict to these methods (empty: each scenario's list).
     pub methods: Vec<String>,
@@ -36,6 +39,8 @@ pub struct SuiteRun {
     pub results: Vec<CaseResult>,
     pub scenarios: Vec<LoadedScenario>,
     pub data_source: String,
+    /// What loading the scenarios noticed (dropped or duplicate vertices), each naming its scenario.
+    pub notes: Vec<String>,
 }
 
 impl SuiteOptions {
@@ -65,42 +70,107 @@ pub fn prepare(options: &SuiteOptions) -> Result<(RunConfig, Vec<LoadedScenario>
     for m in &options.methods {
         methods::registry::find(m)?;
     }
-    let mut specs = load_specs(&options.configs_dir.join("scenarios"))?;
+    let specs = select_specs(options)?;
+    let source = options.data_source()?;
+    let mut scenarios = Vec::with_capacity(specs.len());
+    for spec in &specs {
+        scenarios.extend(spec.load(&source)?);
+    }
+    Ok((RunConfig { params, rules }, scenarios, source))
+}
+
+/// The scenario files of the run: every one in the scenarios directory, or the ones named (by name, or
+/// by the path of a `.toml` file anywhere).
+fn select_specs(options: &SuiteOptions) -> Result<Vec<ScenarioSpec>, HarnessError> {
+    let dir = options.scenarios_dir.clone().unwrap_or_else(|| options.configs_dir.join("scenarios"));
+    let is_path = |s: &str| s.ends_with(".toml") || s.contains(std::path::MAIN_SEPARATOR);
+    let named: Vec<&String> = options.scenarios.iter().filter(|s| !is_path(s)).collect();
+    let mut specs =
+        if options.scenarios.is_empty() || !named.is_empty() { load_specs(&dir)? } else { Vec::new() };
     if !options.scenarios.is_empty() {
-        for name in &options.scenarios {
-            if !specs.iter().any(|s| &s.name == name) {
+        for name in &named {
+            if !specs.iter().any(|s| &&s.name == name) {
                 let known: Vec<&str> = specs.iter().map(|s| s.name.as_str()).collect();
                 return Err(HarnessError::Scenario {
-                    scenario: name.clone(),
-                    message: format!("no such scenario; known: {}", known.join(", ")),
+                    scenario: name.to_string(),
+                    message: format!("no such scenario in {}; known: {}", dir.display(), known.join(", ")),
                 });
             }
         }
-        specs.retain(|s| options.scenarios.contains(&s.name));
+        specs.retain(|s| named.contains(&&s.name));
+        for path in options.scenarios.iter().filter(|s| is_path(s)) {
+            let spec = load_spec(Path::new(path))?;
+            if specs.iter().any(|s| s.name == spec.name) {
+                return Err(HarnessError::Config {
+                    path: path.into(),
+                    message: format!("scenario name `{}` is given twice", spec.name),
+                });
+            }
+            specs.push(spec);
+        }
     }
-    let source = options.data_source()?;
-    let scenarios = specs.iter().map(|s| s.load(&source)).collect::<Result<Vec<_>, _>>()?;
-    Ok((RunConfig { params, rules }, scenarios, source))
+    Ok(specs)
+}
+
+/// The methods of each scenario the run covers (`options.methods` applied), in registry order.
+fn plan(options: &SuiteOptions, scenarios: &[LoadedScenario]) -> Vec<Vec<&'static str>> {
+    scenarios
+        .iter()
+        .map(|s| {
+            s.spec
+                .method_names()
+                .into_iter()
+                .filter(|m| options.methods.is_empty() || options.methods.iter().any(|x| x == m))
+                .collect()
+        })
+        .collect()
 }
 
 /// Run every selected method on every scenario. [`REFERENCE_METHOD`] runs first in each scenario so
 /// the others can be compared with it; results are reported in registry order.
 pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
     let (config, scenarios, source) = prepare(options)?;
-    let plan: Vec<(usize, Vec<&'static str>)> = scenarios
+    let plan = plan(options, &scenarios);
+    let results = run_plan(options, &config, &scenarios, &plan);
+    let data_source = describe_data(&source, &scenarios);
+    Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source })
+}
+
+/// Run the scenarios of part `shard` of the suite ([`crate::shard::assign`] on their estimated cost).
+pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, HarnessError> {
+    let (config, scenarios, source) = prepare(options)?;
+    let data_source = describe_data(&source, &scenarios);
+    let plan = plan(options, &scenarios);
+    let costs: Vec<f64> = scenarios.iter().zip(&plan).map(|(s, m)| estimated_cost(s, m)).collect();
+    let shard_of = assign(&costs, shard.count);
+    let (mine, plan): (Vec<(LoadedScenario, bool)>, Vec<Vec<&'static str>>) = scenarios
+        .into_iter()
+        .zip(plan)
+        .zip(&shard_of)
+        .map(|((s, p), &k)| ((s, k + 1 == shard.index), p))
+        .filter(|((_, keep), _)| *keep)
+        .unzip();
+    let scenarios: Vec<LoadedScenario> = mine.into_iter().map(|(s, _)| s).collect();
+    let results = run_plan(options, &config, &scenarios, &plan);
+    Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source })
+}
+
+/// The notes of every scenario, each named.
+fn notes_of(scenarios: &[LoadedScenario]) -> Vec<String> {
+    scenarios
         .iter()
-        .enumerate()
-        .map(|(i, s)| {
-            let names = s
-                .spec
-                .method_names()
-                .into_iter()
-                .filter(|m| options.methods.is_empty() || options.methods.iter().any(|x| x == m))
-                .collect();
-            (i, names)
-        })
-        .collect();
-    let total: usize = plan.iter().map(|(_, m)| m.len()).sum();
+        .flat_map(|s| s.notes.iter().map(move |n| format!("scenario `{}`: {n}", s.spec.name)))
+        .collect()
+}
+
+/// Run `plan[i]` (method names) on `scenarios[i]` for every `i`.
+fn run_plan(
+    options: &SuiteOptions,
+    config: &RunConfig,
+    scenarios: &[LoadedScenario],
+    plan: &[Vec<&'static str>],
+) -> Vec<CaseResult> {
+    let total: usize = plan.iter().map(Vec::len).sum();
     let bar = if options.progress { ProgressBar::new(total as u64) } else { ProgressBar::hidden() };
     bar.set_style(
         ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {msg}")
@@ -108,8 +178,7 @@ pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
             .progress_chars("=> "),
     );
     let mut results = Vec::with_capacity(total);
-    for (i, names) in plan {
-        let scenario = &scenarios[i];
+    for (scenario, names) in scenarios.iter().zip(plan) {
         let rest = RestGeometry::new(&scenario.mesh, &scenario.topology);
         let mut order = names.clone();
         order.sort_by_key(|m| *m != REFERENCE_METHOD);
@@ -134,18 +203,101 @@ pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
         results.extend(cases);
     }
     bar.finish_and_clear();
-    let n_survey = scenarios.iter().filter(|s| s.mesh_source == "survey").count();
-    let data_source = match (&source, n_survey) {
-        (DataSource::Survey(dir), n) if n == scenarios.len() => format!("survey data from {}", dir.display()),
-        (_, 0) => "procedural look-alikes of the survey shapes".to_string(),
-        (DataSource::Survey(dir), n) => format!(
-            "survey data from {} for {n} scenario(s), procedural look-alikes for the other {}",
-            dir.display(),
-            scenarios.len() - n
-        ),
-        (DataSource::Procedural, _) => unreachable!("survey meshes are only loaded from a survey directory"),
+    results
+}
+
+/// The run that the partial reports in `dirs` (of `all --shard K/N` with these `options`, K = 1..N)
+/// make up together: their cases in the order one run reports them, each result's shape read back
+/// from its mesh file. Errors: a missing or repeated part, parts of different runs (data source or
+/// N), a case of a scenario the options do not load, a mesh that does not fit its scenario.
+pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, HarnessError> {
+    let (_, scenarios, source) = prepare(options)?;
+    let data_source = describe_data(&source, &scenarios);
+    let mut parts: Vec<(Shard, PathBuf, Vec<CaseResult>)> = Vec::with_capacity(dirs.len());
+    for dir in dirs {
+        let path = dir.join("results.json");
+        let crate::report::StoredReport { cases, data_source: their_source, shard } =
+            crate::report::read_results(&path)?;
+        let config = |message: String| HarnessError::Config { path: path.clone(), message };
+        let shard = shard.ok_or_else(|| config("not a partial report (written without --shard)".into()))?;
+        if their_source != data_source {
+            return Err(config(format!("ran on {their_source}, but this merge loads {data_source}")));
+        }
+        if let Some((other, other_dir, _)) = parts.iter().find(|(s, _, _)| s.index == shard.index) {
+            return Err(config(format!("part {other} is also in {}", other_dir.display())));
+        }
+        if let Some((other, _, _)) = parts.iter().find(|(s, _, _)| s.count != shard.count) {
+            return Err(config(format!("is part {shard}, but another part is {other}")));
+        }
+        parts.push((shard, dir.clone(), cases));
+    }
+    let count = parts[0].0.count;
+    let missing: Vec<String> = (1..=count)
+        .filter(|k| !parts.iter().any(|(s, _, _)| s.index == *k))
+        .map(|k| format!("{k}/{count}"))
+        .collect();
+    if !missing.is_empty() {
+        return Err(HarnessError::Config {
+            path: dirs[0].clone(),
+            message: format!("the merge lacks part(s) {}", missing.join(", ")),
+        });
+    }
+    let plan = plan(options, &scenarios);
+    let mut results: Vec<(usize, usize, CaseResult)> = Vec::new();
+    for (_, dir, cases) in parts {
+        for mut case in cases {
+            let fail = |message: String| HarnessError::Config { path: dir.join("results.json"), message };
+            let Some(i) = scenarios.iter().position(|s| s.spec.name == case.scenario) else {
+                return Err(fail(format!(
+                    "scenario `{}` is not among the scenarios this merge loads",
+                    case.scenario
+                )));
+            };
+            let order = plan[i].iter().position(|m| *m == case.method).unwrap_or(usize::MAX);
+            if !case.status.is_failed() {
+                let mesh_path = dir.join("meshes").join(format!("{}-{}.off", case.scenario, case.method));
+                let mesh = meshes::io::read_mesh(&mesh_path)?;
+                case.positions = Some(
+                    scenarios[i]
+                        .from_input_order(mesh.positions())
+                        .map_err(|m| HarnessError::Config { path: mesh_path.clone(), message: m })?,
+                );
+            }
+            results.push((i, order, case));
+        }
+    }
+    results.sort_by_key(|(i, order, _)| (*i, *order));
+    let results: Vec<CaseResult> = results.into_iter().map(|(_, _, c)| c).collect();
+    Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source })
+}
+
+/// One line on where the meshes of `scenarios` came from.
+fn describe_data(source: &DataSource, scenarios: &[LoadedScenario]) -> String {
+    let count = |what: &str| scenarios.iter().filter(|s| s.mesh_source == what).count();
+    let (survey, procedural, files) = (count("survey"), count("procedural look-alike"), count(FILE_SOURCE));
+    let survey_part = match source {
+        DataSource::Survey(dir) => format!("survey data from {}", dir.display()),
+        DataSource::Procedural => "survey data".to_string(),
     };
-    Ok(SuiteRun { results, scenarios, data_source })
+    let n = scenarios.len();
+    match (survey, procedural, files) {
+        (s, 0, 0) if s == n => survey_part,
+        (0, p, 0) if p == n => "procedural look-alikes of the survey shapes".to_string(),
+        (0, 0, f) if f == n => "mesh files named by the scenarios".to_string(),
+        _ => {
+            let mut parts = Vec::new();
+            if survey > 0 {
+                parts.push(format!("{survey_part} for {survey} scenario(s)"));
+            }
+            if procedural > 0 {
+                parts.push(format!("procedural look-alikes for {procedural}"));
+            }
+            if files > 0 {
+                parts.push(format!("mesh files for {files}"));
+            }
+            parts.join(", ")
+        }
+    }
 }
 
 /// The workspace root (configs/ and reports/ live there), from the harness crate's location.

@@ -34,6 +34,15 @@ pub fn survey_dir() -> Option<PathBuf> {
     }
 }
 
+/// The real-mesh directory named by `$DEFORM_REAL_MESHES_DIR` (the scenarios of `configs/real-meshes`
+/// read it from there; `scripts/test` sets it to `../shared/real-meshes`).
+pub fn real_meshes_dir() -> Option<PathBuf> {
+    match std::env::var_os("DEFORM_REAL_MESHES_DIR").map(PathBuf::from) {
+        Some(dir) if dir.join("decimated-knight.off").is_file() => Some(dir),
+        _ => unavailable("the real meshes (DEFORM_REAL_MESHES_DIR)"),
+    }
+}
+
 /// The cross-check interpreter: `$DEFORMBENCH_PYTHON` (set up by scripts/python-env).
 pub fn python() -> Option<PathBuf> {
     match std::env::var_os("DEFORMBENCH_PYTHON") {

@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use crate::case::CaseResult;
 use crate::error::HarnessError;
 use crate::metrics::Metric;
-use crate::scenario::LoadedScenario;
+use crate::scenario::{LoadedScenario, Role};
 
 use super::camera::{Camera, VIEW_FROM};
 use super::canvas::RgbImage;
@@ -187,11 +187,13 @@ fn method_columns(results: &[CaseResult]) -> Vec<String> {
     columns
 }
 
-/// `#V` roles from the scenario's last handle set (which holds every region of the earlier steps).
+/// `#V` roles from the scenario's last handle set (which holds every region of the earlier steps):
+/// fixed regions blue, every other region orange.
 fn vertex_roles(scenario: &LoadedScenario) -> Vec<VertexRole> {
     let mut roles = vec![VertexRole::Free; scenario.mesh.n_vertices()];
-    for region in scenario.steps.last().map(|s| s.handles.regions()).unwrap_or_default() {
-        let role = if region.name == "fixed" { VertexRole::Fixed } else { VertexRole::Handle };
+    let Some(step) = scenario.steps.last() else { return roles };
+    for (region, role) in step.handles.regions().iter().zip(&step.roles) {
+        let role = if *role == Role::Fixed { VertexRole::Fixed } else { VertexRole::Handle };
         for &v in &region.vertices {
             if let Some(slot) = roles.get_mut(v as usize) {
                 *slot = role;
@@ -557,15 +559,7 @@ mod tests {
             HandleRegion { name: "handle".into(), vertices: of(VertexStatus::Handle) },
         ];
         let handles = HandleSet::new(regions, shape.mesh.n_vertices()).unwrap();
-        let spec = ScenarioSpec {
-            name: name.into(),
-            description: String::new(),
-            survey: None,
-            procedural: None,
-            methods: None,
-            steps: Vec::new(),
-            path: PathBuf::new(),
-        };
+        let spec = ScenarioSpec { name: name.into(), ..Default::default() };
         LoadedScenario {
             spec,
             mesh_source: "procedural look-alike".into(),
@@ -574,7 +568,10 @@ mod tests {
             steps: vec![LoadedStep {
                 handles,
                 motions: vec![Motion::Hold, Motion::Transform(shape.transform)],
+                roles: vec![Role::Fixed, Role::Handle],
             }],
+            input: None,
+            notes: Vec::new(),
         }
     }
 

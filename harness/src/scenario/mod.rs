@@ -1,0 +1,713 @@
+//! Scenarios: a mesh (survey file, procedural look-alike, or any mesh file by path, alone or as a
+//! collection), its regions and their edits, the methods to run. One TOML file per scenario in
+//! `configs/scenarios/` (or any file given by path).
+//!
+//! ```toml
+//! name = "knight"
+//! mesh = "${DEFORM_REAL_MESHES_DIR}/decimated-knight.off"   # OFF, OBJ, PLY, glTF/GLB; relative to this file
+//! # meshes = "models/*.ply"                                 # a collection: one case per mesh x method
+//! [[regions]]                                               # see `selection` and `motion`
+//! name = "base"
+//! role = "fixed"
+//! select = { dmat = { file = "${DEFORM_REAL_MESHES_DIR}/decimated-knight-selection.dmat", id = 0 } }
+//! [[regions]]
+//! name = "head"
+//! role = "handle"
+//! select = { dmat = { file = "${DEFORM_REAL_MESHES_DIR}/decimated-knight-selection.dmat", id = 1 } }
+//! rotate = { axis = [0, 0, 1], degrees = 30 }
+//! ```
+//!
+//! On load a mesh file's unreferenced vertices are dropped (a note says how many; results are still
+//! written in the input's vertex order), exact duplicate vertices are reported, and a connected
+//! component that holds no constrained vertex is an error naming it (its system is singular).
+//!
+//! ```toml
+//! name = "bar"
+//! description = "135 degree twist of the bar about its axis"
+//! survey = "bar"                      # <survey dir>/bar.off, bar.sel, bar.def
+//! procedural = { shape = "bar" }      # used when no survey directory is given
+//! # procedural = { shape = "bar", vertices = 50000 }
+//! # methods = ["laplacian", "arap"]   # default: every registered method
+//! ```
+//!
+//! Incremental editing: `[[steps]]` tables, each a new handle set bound to the result of the step
+//! before (default: one step, the survey edit).
+//!
+//! ```toml
+//! [[steps]]
+//! edit = "survey"        # survey regions: `fixed` held, `handle` moved by the .def transform
+//! [[steps]]
+//! edit = "hold"          # every region of the step before, held where it is
+//! [[steps.patches]]      # plus new handles
+//! name = "middle"
+//! center = [0.5, 0.5, 1.0]       # bbox coordinates of the rest mesh; the nearest vertex is the seed
+//! radius = 0.03                  # vertices within radius x diagonal of the seed (rest positions)
+//! translate = [0.0, 0.0, 0.05]   # target = current position + translate x diagonal
+//! ```
+
+pub mod motion;
+pub mod selection;
+
+use std::path::{Path, PathBuf};
+
+use meshes::shapes::{self, ShapeKind};
+use meshes::{AffineTransform, Topology, TriMesh, VertexStatus};
+use methods::{HandleRegion, HandleSet, HandleTargets};
+use serde::Deserialize;
+
+use crate::error::HarnessError;
+pub use motion::{Motion, RotateSpec, TransformSpec, Units};
+pub use selection::{InputIndex, PathContext, Role, Selection, SelectionFiles};
+
+/// The `mesh_source` of a scenario whose mesh was read from a file named in the scenario.
+pub const FILE_SOURCE: &str = "file";
+
+/// A scenario file as written.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioSpec {
+    /// Unique name, used in reports and on the command line.
+    pub name: String,
+    /// One line for people.
+    #[serde(default)]
+    pub description: String,
+    /// Stem of the survey files (`.off`, `.sel`, `.def`) in the survey directory.
+    #[serde(default)]
+    pub survey: Option<String>,
+    /// Procedural look-alike, used when no survey directory is given or `survey` is absent.
+    #[serde(default)]
+    pub procedural: Option<ProceduralSpec>,
+    /// A mesh file (relative to this file, absolute, or `${VAR}/...`).
+    #[serde(default)]
+    pub mesh: Option<String>,
+    /// A glob of mesh files: one scenario `<name>-<stem>` per match, in sorted order.
+    #[serde(default)]
+    pub meshes: Option<String>,
+    /// The regions of the first edit (default for `survey`/`procedural`: the survey selection).
+    #[serde(default)]
+    pub regions: Vec<RegionSpec>,
+    /// Methods to run (default: all registered).
+    #[serde(default)]
+    pub methods: Option<Vec<String>>,
+    /// Edit steps (default: the survey edit alone).
+    #[serde(default)]
+    pub steps: Vec<StepSpec>,
+    /// The file it was read from.
+    #[serde(skip)]
+    pub path: PathBuf,
+}
+
+/// A region as written: its vertices and, for a handle, its transform (see [`motion`]).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegionSpec {
+    pub name: String,
+    pub role: Role,
+    pub select: Selection,
+    #[serde(default)]
+    pub rotate: Option<RotateSpec>,
+    #[serde(default)]
+    pub scale: Option<f64>,
+    #[serde(default)]
+    pub translate: Option<[f64; 3]>,
+    #[serde(default)]
+    pub translate_units: Units,
+    #[serde(default)]
+    pub def: Option<String>,
+}
+
+impl RegionSpec {
+    fn transform(&self) -> TransformSpec {
+        TransformSpec {
+            rotate: self.rotate.clone(),
+            scale: self.scale,
+            translate: self.translate,
+            translate_units: self.translate_units,
+            def: self.def.clone(),
+        }
+    }
+}
+
+/// A procedural mesh request.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProceduralSpec {
+    /// `bar`, `cylinder`, `cactus` or `plane`.
+    pub shape: String,
+    /// Approximate vertex count (default: the survey original's).
+    #[serde(default)]
+    pub vertices: Option<usize>,
+}
+
+/// One edit step as written.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StepSpec {
+    /// How the regions of the step before carry over.
+    pub edit: StepEdit,
+    /// New patch handles.
+    #[serde(default)]
+    pub patches: Vec<PatchSpec>,
+}
+
+/// How a step starts its handle set.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum StepEdit {
+    /// The survey regions: `fixed` held, `handle` moved by the survey transform.
+    Survey,
+    /// The scenario's `[[regions]]`: fixed ones held, handles moved by their transforms.
+    Regions,
+    /// Every region of the step before, held at its current position.
+    Hold,
+}
+
+/// A patch handle: the vertices near a point of the rest mesh, translated.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PatchSpec {
+    pub name: String,
+    /// A point in the rest bounding box, in `[0, 1]^3` box coordinates; the nearest vertex is the seed.
+    pub center: [f64; 3],
+    /// Radius around the seed, as a fraction of the bounding-box diagonal.
+    pub radius: f64,
+    /// Target offset, as a fraction of the bounding-box diagonal (default: held in place).
+    #[serde(default)]
+    pub translate: [f64; 3],
+}
+
+/// A resolved step: its handle set and how each region moves.
+#[derive(Clone, Debug)]
+pub struct LoadedStep {
+    pub handles: HandleSet,
+    /// One per region of `handles`, in order.
+    pub motions: Vec<Motion>,
+    /// One per region of `handles`: `Fixed` or `Handle` (for the figures' colours).
+    pub roles: Vec<Role>,
+}
+
+impl LoadedStep {
+    /// Targets of the constrained vertices for the `#V x 3` shape `current` the step starts from.
+    pub fn targets(&self, current: &[[f64; 3]]) -> Result<HandleTargets, methods::MethodError> {
+        let mut out = Vec::with_capacity(self.handles.n_constrained());
+        for (region, motion) in self.handles.regions().iter().zip(&self.motions) {
+            out.extend(region.vertices.iter().map(|&v| {
+                let p = current[v as usize];
+                match motion {
+                    Motion::Hold => p,
+                    Motion::Transform(t) => t.apply(p),
+                    Motion::Translate(d) => [p[0] + d[0], p[1] + d[1], p[2] + d[2]],
+                }
+            }));
+        }
+        HandleTargets::new(&self.handles, out)
+    }
+}
+
+/// Where meshes come from for this run.
+#[derive(Clone, Debug)]
+pub enum DataSource {
+    /// The original survey files in this directory.
+    Survey(PathBuf),
+    /// Procedural look-alikes.
+    Procedural,
+}
+
+/// A scenario ready to run: validated mesh, handles and targets.
+pub struct LoadedScenario {
+    pub spec: ScenarioSpec,
+    /// `survey`, `procedural look-alike` or `file`, printed in every report row.
+    pub mesh_source: String,
+    pub mesh: TriMesh,
+    pub topology: Topology,
+    /// The edit steps, at least one.
+    pub steps: Vec<LoadedStep>,
+    /// The mesh file as read, when unreferenced vertices were dropped from it: results are written in
+    /// its vertex order ([`LoadedScenario::in_input_order`]).
+    pub input: Option<InputMesh>,
+    /// What loading noticed (dropped or duplicate vertices), for the run's output and the page.
+    pub notes: Vec<String>,
+}
+
+/// A mesh file as read, and which of its vertices the scenario's mesh kept.
+#[derive(Clone, Debug)]
+pub struct InputMesh {
+    pub mesh: TriMesh,
+    /// Mesh vertex `i` is input vertex `kept[i]`.
+    pub kept: Vec<u32>,
+}
+
+impl LoadedScenario {
+    /// `#V x 3` positions on this scenario's mesh from positions in the input file's vertex order (the
+    /// inverse of [`LoadedScenario::in_input_order`]).
+    pub fn from_input_order(&self, positions: &[[f64; 3]]) -> Result<Vec<[f64; 3]>, String> {
+        let expected = self.input.as_ref().map_or(self.mesh.n_vertices(), |i| i.mesh.n_vertices());
+        if positions.len() != expected {
+            return Err(format!("has {} vertices, the scenario's mesh {expected}", positions.len()));
+        }
+        Ok(match &self.input {
+            None => positions.to_vec(),
+            Some(input) => input.kept.iter().map(|&v| positions[v as usize]).collect(),
+        })
+    }
+
+    /// The mesh with `#V x 3` `positions` (a result on this scenario's mesh), in the input file's
+    /// vertex order: dropped vertices at their input position, faces as in the file.
+    pub fn in_input_order(&self, positions: &[[f64; 3]]) -> Result<TriMesh, meshes::MeshError> {
+        match &self.input {
+            None => self.mesh.with_positions(positions.to_vec()),
+            Some(input) => {
+                let mut out = input.mesh.positions().to_vec();
+                for (p, &v) in positions.iter().zip(&input.kept) {
+                    out[v as usize] = *p;
+                }
+                input.mesh.with_positions(out)
+            }
+        }
+    }
+}
+
+/// Read every `*.toml` in `dir`, sorted by file name; names must be unique.
+pub fn load_specs(dir: &Path) -> Result<Vec<ScenarioSpec>, HarnessError> {
+    let entries =
+        std::fs::read_dir(dir).map_err(|error| HarnessError::Io { path: dir.to_path_buf(), error })?;
+    let mut paths: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    paths.sort();
+    let mut specs: Vec<ScenarioSpec> = Vec::with_capacity(paths.len());
+    for path in paths {
+        let spec = load_spec(&path)?;
+        if let Some(other) = specs.iter().find(|s| s.name == spec.name) {
+            return Err(HarnessError::Config {
+                path,
+                message: format!("scenario name `{}` is already used by {}", spec.name, other.path.display()),
+            });
+        }
+        specs.push(spec);
+    }
+    if specs.is_empty() {
+        return Err(HarnessError::Config {
+            path: dir.to_path_buf(),
+            message: "no scenario files (*.toml)".into(),
+        });
+    }
+    Ok(specs)
+}
+
+/// Read and check one scenario file.
+pub fn load_spec(path: &Path) -> Result<ScenarioSpec, HarnessError> {
+    let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
+    let text = std::fs::read_to_string(path)
+        .map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
+    let mut spec: ScenarioSpec = toml::from_str(&text).map_err(|e| config(e.to_string()))?;
+    spec.path = path.to_path_buf();
+    let builtin = spec.survey.is_some() || spec.procedural.is_some();
+    let files = spec.mesh.is_some() as usize + spec.meshes.is_some() as usize;
+    match (builtin, files) {
+        (false, 0) => {
+            return Err(config("a scenario needs a mesh: `mesh`, `meshes`, `survey` or `procedural`".into()))
+        }
+        (true, 1..) => {
+            return Err(config(
+                "give either a mesh file (`mesh`, `meshes`) or `survey`/`procedural`, not both".into(),
+            ))
+        }
+        (_, 2) => return Err(config("give one of `mesh` (a file) and `meshes` (a glob), not both".into())),
+        _ => {}
+    }
+    if files > 0 && spec.regions.is_empty() {
+        return Err(config("a mesh file needs its [[regions]] (at least one fixed or handle region)".into()));
+    }
+    if let Some(p) = &spec.procedural {
+        p.shape.parse::<ShapeKind>().map_err(|e| config(format!("procedural.shape: {e}")))?;
+    }
+    for m in spec.methods.iter().flatten() {
+        methods::registry::find(m).map_err(|e| config(e.to_string()))?;
+    }
+    Ok(spec)
+}
+
+/// The first edit of a scenario: its regions, how each moves and its role.
+struct InitialEdit {
+    regions: Vec<HandleRegion>,
+    motions: Vec<Motion>,
+    roles: Vec<Role>,
+}
+
+/// The per-vertex files of a mesh file with `n_input` vertices, read with the mesh crate's readers.
+struct InputFiles {
+    n_input: usize,
+}
+
+impl SelectionFiles for InputFiles {
+    fn sel(&self, file: &Path) -> Result<Vec<u8>, String> {
+        let codes = meshes::io::read_selection(file, self.n_input).map_err(|e| e.to_string())?;
+        Ok(codes.into_iter().map(VertexStatus::code).collect())
+    }
+
+    fn dmat(&self, file: &Path) -> Result<Vec<i64>, String> {
+        meshes::io::read_dmat_column(file, self.n_input).map_err(|e| e.to_string())
+    }
+
+    fn index_list(&self, file: &Path) -> Result<Vec<u32>, String> {
+        meshes::io::read_index_list(file).map_err(|e| e.to_string())
+    }
+}
+
+impl ScenarioSpec {
+    /// Methods to run on this scenario, in registry order.
+    pub fn method_names(&self) -> Vec<&'static str> {
+        let all = methods::registry::method_names();
+        match &self.methods {
+            Some(list) => all.into_iter().filter(|m| list.iter().any(|l| l == m)).collect(),
+            None => all,
+        }
+    }
+
+    /// Where this scenario's relative paths start.
+    fn paths(&self, stem: Option<String>) -> PathContext {
+        let base = self.path.parent().map(Path::to_path_buf).unwrap_or_default();
+        PathContext { base, stem }
+    }
+
+    /// Load the mesh(es) and edit and validate them: one scenario, or one per file of a collection
+    /// (`meshes`), named `<name>-<file stem>`.
+    pub fn load(&self, source: &DataSource) -> Result<Vec<LoadedScenario>, HarnessError> {
+        let fail = |message: String| HarnessError::Scenario { scenario: self.name.clone(), message };
+        if let Some(pattern) = &self.meshes {
+            let resolved = self.paths(None).resolve(pattern).map_err(fail)?;
+            let text = resolved.to_string_lossy().into_owned();
+            let mut paths: Vec<PathBuf> = glob::glob(&text)
+                .map_err(|e| fail(format!("meshes = \"{pattern}\": not a glob pattern: {e}")))?
+                .filter_map(Result::ok)
+                .filter(|p| p.is_file())
+                .collect();
+            paths.sort();
+            if paths.is_empty() {
+                return Err(fail(format!("meshes = \"{pattern}\" ({text}) matches no file")));
+            }
+            return paths
+                .iter()
+                .map(|p| {
+                    let stem = file_stem(p);
+                    self.load_file(p, &format!("{}-{stem}", self.name), Some(stem))
+                })
+                .collect();
+        }
+        if let Some(mesh) = &self.mesh {
+            let path = self.paths(None).resolve(mesh).map_err(fail)?;
+            let stem = file_stem(&path);
+            return Ok(vec![self.load_file(&path, &self.name, Some(stem))?]);
+        }
+        Ok(vec![self.load_builtin(source)?])
+    }
+
+    /// A survey mesh or procedural look-alike, with the survey edit or the scenario's regions.
+    fn load_builtin(&self, source: &DataSource) -> Result<LoadedScenario, HarnessError> {
+        let fail = |message: String| HarnessError::Scenario { scenario: self.name.clone(), message };
+        let (mesh, topology, selection, transform, mesh_source) = match (
+            source,
+            &self.survey,
+            &self.procedural,
+        ) {
+            (DataSource::Survey(dir), Some(stem), _) => {
+                let mesh_path = dir.join(format!("{stem}.off"));
+                let mesh = meshes::io::read_mesh(&mesh_path)?;
+                mesh.check_nondegenerate().map_err(|e| e.in_file(&mesh_path))?;
+                let topology = Topology::new(&mesh).map_err(|e| e.in_file(&mesh_path))?;
+                let selection =
+                    meshes::io::read_selection(dir.join(format!("{stem}.sel")), mesh.n_vertices())?;
+                let transform = meshes::io::read_transform(dir.join(format!("{stem}.def")))?;
+                (mesh, topology, selection, transform, "survey".to_string())
+            }
+            (_, _, Some(p)) => {
+                let kind: ShapeKind = p.shape.parse().map_err(|e| fail(format!("{e}")))?;
+                let target = p.vertices.unwrap_or_else(|| shapes::default_vertex_count(kind));
+                let shape = shapes::generate(kind, target)?;
+                shape.mesh.check_nondegenerate()?;
+                let topology = Topology::new(&shape.mesh)?;
+                (shape.mesh, topology, shape.selection, shape.transform, "procedural look-alike".to_string())
+            }
+            (DataSource::Procedural, Some(_), None) => return Err(fail(
+                "needs the survey data (--survey-dir or DEFORM_SURVEY_DIR) and has no `procedural` fallback"
+                    .into(),
+            )),
+            (_, None, None) => return Err(fail("has neither `survey` nor `procedural`".into())),
+        };
+        let initial = if self.regions.is_empty() {
+            let (regions, motions) =
+                survey_regions(&selection, &transform).map_err(|e| fail(e.to_string()))?;
+            let roles =
+                regions.iter().map(|r| if r.name == "fixed" { Role::Fixed } else { Role::Handle }).collect();
+            InitialEdit { regions, motions, roles }
+        } else {
+            let input = InputIndex::identity(mesh.n_vertices());
+            let files = InputFiles { n_input: mesh.n_vertices() };
+            self.regions_edit(&mesh, &input, &self.paths(None), &files).map_err(fail)?
+        };
+        let steps = self.resolve_steps(&mesh, &initial).map_err(fail)?;
+        check_components(&mesh, &steps, None).map_err(fail)?;
+        Ok(LoadedScenario {
+            spec: self.clone(),
+            mesh_source,
+            mesh,
+            topology,
+            steps,
+            input: None,
+            notes: Vec::new(),
+        })
+    }
+
+    /// The mesh file `path` as the scenario `name` (its `{stem}` for the region files).
+    fn load_file(
+        &self,
+        path: &Path,
+        name: &str,
+        stem: Option<String>,
+    ) -> Result<LoadedScenario, HarnessError> {
+        let fail = |message: String| HarnessError::Scenario { scenario: name.to_string(), message };
+        let input = meshes::io::read_mesh(path)?;
+        let (mesh, map) = meshes::clean::drop_unreferenced(&input);
+        let mut notes = Vec::new();
+        let dropped = map.dropped();
+        if !dropped.is_empty() {
+            notes.push(format!(
+                "{}: {} unreferenced vertices dropped (e.g. vertex {}); results are written in the file's vertex order",
+                path.display(),
+                dropped.len(),
+                dropped[0]
+            ));
+        }
+        let duplicates = meshes::clean::exact_duplicate_vertices(mesh.positions());
+        if let Some((a, b)) = duplicates.first() {
+            notes.push(format!(
+                "{}: {} exact duplicate vertices (e.g. mesh vertices {a} and {b} at the same position); they are kept as distinct vertices",
+                path.display(),
+                duplicates.len()
+            ));
+        }
+        mesh.check_nondegenerate().map_err(|e| e.in_file(path))?;
+        let topology = Topology::new(&mesh).map_err(|e| e.in_file(path))?;
+        let mut kept_of_input = vec![None; input.n_vertices()];
+        for (i, &v) in map.kept().iter().enumerate() {
+            kept_of_input[v as usize] = Some(i as u32);
+        }
+        let index = InputIndex { kept_of_input };
+        let files = InputFiles { n_input: input.n_vertices() };
+        let initial = self.regions_edit(&mesh, &index, &self.paths(stem), &files).map_err(fail)?;
+        let mut spec = self.clone();
+        spec.name = name.to_string();
+        let steps = spec.resolve_steps(&mesh, &initial).map_err(fail)?;
+        let kept = map.kept().to_vec();
+        check_components(&mesh, &steps, Some(&kept)).map_err(|e| fail(format!("{}: {e}", path.display())))?;
+        let input = (!dropped.is_empty()).then(|| InputMesh { mesh: input, kept });
+        Ok(LoadedScenario { spec, mesh_source: FILE_SOURCE.to_string(), mesh, topology, steps, input, notes })
+    }
+
+    /// The `[[regions]]` on `mesh`: vertices selected (file-based selections through `input`), free
+    /// regions taken out of the others, motions resolved. Errors name the region.
+    fn regions_edit(
+        &self,
+        mesh: &TriMesh,
+        input: &InputIndex,
+        paths: &PathContext,
+        files: &dyn SelectionFiles,
+    ) -> Result<InitialEdit, String> {
+        let mut selected = Vec::with_capacity(self.regions.len());
+        for r in &self.regions {
+            let vertices = r
+                .select
+                .vertices(mesh.positions(), input, paths, files)
+                .map_err(|e| format!("region `{}`: {e}", r.name))?;
+            selected.push(vertices);
+        }
+        let mut free = vec![false; mesh.n_vertices()];
+        for (r, vertices) in self.regions.iter().zip(&selected) {
+            if r.role == Role::Free {
+                if !r.transform().is_empty() {
+                    return Err(format!("region `{}`: a free region has no transform", r.name));
+                }
+                vertices.iter().for_each(|&v| free[v as usize] = true);
+            }
+        }
+        let mut edit = InitialEdit { regions: Vec::new(), motions: Vec::new(), roles: Vec::new() };
+        for (r, vertices) in self.regions.iter().zip(selected) {
+            if r.role == Role::Free {
+                continue;
+            }
+            let vertices: Vec<u32> = vertices.into_iter().filter(|&v| !free[v as usize]).collect();
+            if vertices.is_empty() {
+                return Err(format!("region `{}`: every vertex it selects is in a free region", r.name));
+            }
+            let transform = r.transform();
+            let motion = match r.role {
+                Role::Fixed if !transform.is_empty() => {
+                    return Err(format!(
+                        "region `{}`: a fixed region is held; give a transform to a handle",
+                        r.name
+                    ))
+                }
+                Role::Fixed => Motion::Hold,
+                _ => transform
+                    .resolve(mesh, &vertices, paths)
+                    .map_err(|e| format!("region `{}`: {e}", r.name))?,
+            };
+            edit.regions.push(HandleRegion { name: r.name.clone(), vertices });
+            edit.motions.push(motion);
+            edit.roles.push(r.role);
+        }
+        if edit.regions.is_empty() {
+            return Err("[[regions]] has no fixed or handle region".into());
+        }
+        Ok(edit)
+    }
+
+    /// The handle sets of the steps on the rest mesh (default: the initial edit alone).
+    fn resolve_steps(&self, mesh: &TriMesh, initial: &InitialEdit) -> Result<Vec<LoadedStep>, String> {
+        let first = if self.regions.is_empty() { StepEdit::Survey } else { StepEdit::Regions };
+        let default = [StepSpec { edit: first, patches: Vec::new() }];
+        let specs = if self.steps.is_empty() { &default[..] } else { &self.steps[..] };
+        let diagonal = mesh.bbox_diagonal();
+        let (lo, hi) = mesh.bbox();
+        let mut steps: Vec<LoadedStep> = Vec::with_capacity(specs.len());
+        for (i, spec) in specs.iter().enumerate() {
+            let at = |message: String| format!("step {}: {message}", i + 1);
+            let (mut regions, mut motions, mut roles) = match spec.edit {
+                StepEdit::Survey if !self.regions.is_empty() => {
+                    return Err(at("this scenario has [[regions]]: its edit is `edit = \"regions\"`".into()))
+                }
+                StepEdit::Regions if self.regions.is_empty() => {
+                    return Err(at("`edit = \"regions\"` needs [[regions]] in the scenario".into()))
+                }
+                StepEdit::Survey | StepEdit::Regions => {
+                    (initial.regions.clone(), initial.motions.clone(), initial.roles.clone())
+                }
+                StepEdit::Hold => {
+                    let Some(previous) = steps.last() else {
+                        return Err(at("`edit = \"hold\"` needs a step before it".into()));
+                    };
+                    (
+                        previous.handles.regions().to_vec(),
+                        vec![Motion::Hold; previous.handles.regions().len()],
+                        previous.roles.clone(),
+                    )
+                }
+            };
+            let mut taken = vec![false; mesh.n_vertices()];
+            for r in &regions {
+                r.vertices.iter().for_each(|&v| taken[v as usize] = true);
+            }
+            for patch in &spec.patches {
+                let at = |message: String| at(format!("patch `{}`: {message}", patch.name));
+                if !(patch.radius > 0.0 && patch.radius.is_finite())
+                    || patch.center.iter().chain(&patch.translate).any(|c| !c.is_finite())
+                {
+                    return Err(at("radius must be positive and finite, center and translate finite".into()));
+                }
+                let point: [f64; 3] = std::array::from_fn(|c| lo[c] + patch.center[c] * (hi[c] - lo[c]));
+                let p = mesh.positions();
+                let distance = |v: usize| meshes::vector::norm(meshes::vector::sub(p[v], point));
+                let seed = (0..p.len())
+                    .min_by(|&a, &b| distance(a).total_cmp(&distance(b)))
+                    .expect("non-empty mesh");
+                let reach = patch.radius * diagonal;
+                let vertices: Vec<u32> = (0..p.len())
+                    .filter(|&v| {
+                        !taken[v] && meshes::vector::norm(meshes::vector::sub(p[v], p[seed])) <= reach
+                    })
+                    .map(|v| v as u32)
+                    .collect();
+                if vertices.is_empty() {
+                    return Err(at(format!(
+                        "no free vertex within {} x diagonal of vertex {seed}",
+                        patch.radius
+                    )));
+                }
+                vertices.iter().for_each(|&v| taken[v as usize] = true);
+                regions.push(HandleRegion { name: patch.name.clone(), vertices });
+                roles.push(Role::Handle);
+                motions.push(if patch.translate == [0.0; 3] {
+                    Motion::Hold
+                } else {
+                    Motion::Translate(patch.translate.map(|c| c * diagonal))
+                });
+            }
+            let handles = HandleSet::new(regions, mesh.n_vertices()).map_err(|e| at(e.to_string()))?;
+            steps.push(LoadedStep { handles, motions, roles });
+        }
+        Ok(steps)
+    }
+}
+
+/// The survey regions: `fixed` (status 0, held; omitted when empty) and `handle` (status 2, moved by
+/// `transform`).
+fn survey_regions(
+    selection: &[VertexStatus],
+    transform: &AffineTransform,
+) -> Result<(Vec<HandleRegion>, Vec<Motion>), methods::MethodError> {
+    let fixed = meshes::edit::vertices_with_status(selection, VertexStatus::Fixed);
+    let handle = meshes::edit::vertices_with_status(selection, VertexStatus::Handle);
+    if handle.is_empty() {
+        return Err(methods::MethodError::Handles("the selection has no handle vertices (code 2)".into()));
+    }
+    let mut regions = Vec::new();
+    let mut motions = Vec::new();
+    if !fixed.is_empty() {
+        regions.push(HandleRegion { name: "fixed".into(), vertices: fixed });
+        motions.push(Motion::Hold);
+    }
+    regions.push(HandleRegion { name: "handle".into(), vertices: handle });
+    motions.push(Motion::Transform(transform.clone()));
+    Ok((regions, motions))
+}
+
+/// The survey edit on the rest mesh as a handle set and its targets: region `fixed` (status 0,
+/// target = rest position, omitted when empty) and region `handle` (status 2, target =
+/// `T (x, y, z, 1)`).
+pub fn survey_edit(
+    mesh: &TriMesh,
+    selection: &[VertexStatus],
+    transform: &AffineTransform,
+) -> Result<(HandleSet, HandleTargets), methods::MethodError> {
+    let (regions, motions) = survey_regions(selection, transform)?;
+    let roles = regions.iter().map(|r| if r.name == "fixed" { Role::Fixed } else { Role::Handle }).collect();
+    let step = LoadedStep { handles: HandleSet::new(regions, mesh.n_vertices())?, motions, roles };
+    let targets = step.targets(mesh.positions())?;
+    Ok((step.handles, targets))
+}
+
+/// The file name of `path` without its extension, for scenario names and `{stem}`.
+fn file_stem(path: &Path) -> String {
+    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+}
+
+/// Every connected component of `mesh` must hold a constrained vertex in every step, or its linear
+/// systems are singular (translations of the component are free). `kept` maps mesh vertices to the
+/// input file's, for the message.
+fn check_components(mesh: &TriMesh, steps: &[LoadedStep], kept: Option<&[u32]>) -> Result<(), String> {
+    let (component, count) = meshes::clean::connected_components(mesh.n_vertices(), mesh.triangles());
+    if count < 2 {
+        return Ok(());
+    }
+    for (i, step) in steps.iter().enumerate() {
+        let mut held = vec![false; count];
+        for v in step.handles.constrained() {
+            held[component[v as usize] as usize] = true;
+        }
+        if let Some(c) = held.iter().position(|h| !h) {
+            let members: Vec<usize> =
+                (0..mesh.n_vertices()).filter(|&v| component[v] as usize == c).collect();
+            let first = members[0];
+            let name = kept.map_or(first as u32, |k| k[first]);
+            return Err(format!(
+                "step {}: connected component {c} of {count} ({} vertices, the first is vertex {name}) has no \
+                 fixed or handle vertex, so its system is singular; select some of its vertices or remove it",
+                i + 1,
+                members.len()
+            ));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,366 @@
+//! Regions of a scenario as data: which vertices a region holds, chosen from a file (a survey `.sel`,
+//! a libigl `.dmat` of region ids, a list of vertex ids) or by a shape in the rest mesh's bounding-box
+//! coordinates (box, sphere, slab), so one rule applies to every mesh of a collection.
+//!
+//! ```toml
+//! [[regions]]
+//! name = "feet"
+//! role = "fixed"                                   # fixed | handle | free
+//! select = { slab = { axis = "z", from = 0.0, to = 0.05 } }   # the lowest 5% along z
+//!
+//! [[regions]]
+//! name = "hand"
+//! role = "handle"
+//! select = { dmat = { file = "{stem}-selection.dmat", id = 1 } }
+//! rotate = { axis = [0, 0, 1], degrees = 30 }       # about the region's centroid
+//! translate = [0.0, 0.0, 0.1]                        # x rest bbox diagonal
+//! ```
+//!
+//! File paths are relative to the scenario file, absolute, or start with `${VARIABLE}` (expanded from
+//! the environment); `{stem}` stands for the mesh file's stem (for collections).
+
+use std::path::{Path, PathBuf};
+
+use meshes::vector::{norm, sub};
+use meshes::TriMesh;
+use serde::Deserialize;
+
+/// What a region does in the edit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    /// Held at its rest position.
+    Fixed,
+    /// Moved by the region's transform.
+    Handle,
+    /// Explicitly free: its vertices are taken out of every fixed or handle region.
+    Free,
+}
+
+/// A coordinate axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Axis {
+    X,
+    Y,
+    Z,
+}
+
+impl Axis {
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// How a region's vertices are chosen. Shapes are in the rest mesh's bounding-box coordinates
+/// (`[0, 1]^3` spans the box), lengths in rest bbox diagonals.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Selection {
+    /// The vertices with `status` (0 fixed, 1 free, 2 handle) in a survey `.sel` file.
+    Sel { file: String, status: u8 },
+    /// The vertices with region id `id` in a libigl `.dmat` (one integer per vertex, -1 free).
+    Dmat { file: String, id: i64 },
+    /// These vertex ids (of the input file's vertex order).
+    Vertices(Vec<u32>),
+    /// The vertex ids listed in a text file (whitespace separated, `#` comments).
+    VertexFile(String),
+    /// The vertices inside the box `min..max` (bbox coordinates, inclusive).
+    Box { min: [f64; 3], max: [f64; 3] },
+    /// The vertices within `radius` (x diagonal) of `center` (bbox coordinates).
+    Sphere { center: [f64; 3], radius: f64 },
+    /// The vertices whose `axis` bbox coordinate lies in `from..=to` (`from = 0, to = 0.05`: the lowest
+    /// 5% of the box along the axis).
+    Slab { axis: Axis, from: f64, to: f64 },
+}
+
+/// Where the files a scenario names are looked up.
+#[derive(Clone, Debug)]
+pub struct PathContext {
+    /// The scenario file's directory.
+    pub base: PathBuf,
+    /// The mesh file's stem, for `{stem}` (collections).
+    pub stem: Option<String>,
+}
+
+impl PathContext {
+    /// `path` as written in the scenario, resolved: `${VAR}` expanded from the environment, `{stem}`
+    /// substituted, relative paths taken from the scenario file's directory.
+    pub fn resolve(&self, path: &str) -> Result<PathBuf, String> {
+        let mut text = path.to_string();
+        if let Some(stem) = &self.stem {
+            text = text.replace("{stem}", stem);
+        } else if text.contains("{stem}") {
+            return Err(format!("`{path}`: {{stem}} needs a mesh file (`mesh` or `meshes`)"));
+        }
+        while let Some(start) = text.find("${") {
+            let Some(len) = text[start..].find('}') else {
+                return Err(format!("`{path}`: unclosed ${{ in the path"));
+            };
+            let name = &text[start + 2..start + len];
+            let value = std::env::var(name).map_err(|_| {
+                format!("`{path}` needs the environment variable {name} (the directory it names)")
+            })?;
+            text.replace_range(start..start + len + 1, &value);
+        }
+        let p = PathBuf::from(text);
+        Ok(if p.is_absolute() { p } else { self.base.join(p) })
+    }
+}
+
+/// The per-vertex files a region may read, one entry per vertex of the input file.
+pub trait SelectionFiles {
+    /// Survey status codes of `file`.
+    fn sel(&self, file: &Path) -> Result<Vec<u8>, String>;
+    /// Region ids of the `.dmat` `file`.
+    fn dmat(&self, file: &Path) -> Result<Vec<i64>, String>;
+    /// Vertex ids listed in `file`.
+    fn index_list(&self, file: &Path) -> Result<Vec<u32>, String>;
+}
+
+/// How the vertices of the input file map to the mesh the methods run on (unreferenced input
+/// vertices are dropped on load).
+#[derive(Clone, Debug, PartialEq)]
+pub struct InputIndex {
+    /// Per input vertex, its index in the mesh, `None` if it was dropped.
+    pub kept_of_input: Vec<Option<u32>>,
+}
+
+impl InputIndex {
+    /// Every input vertex kept, in order.
+    pub fn identity(n: usize) -> Self {
+        Self { kept_of_input: (0..n as u32).map(Some).collect() }
+    }
+
+    pub fn n_input(&self) -> usize {
+        self.kept_of_input.len()
+    }
+}
+
+impl Selection {
+    /// The mesh vertices (ascending, no repeats) this selection picks on the mesh with `#V x 3`
+    /// `positions`; file-based selections index the input file's vertices and are mapped by `input`
+    /// (a dropped vertex is left out). Errors name the file or say why the selection is empty.
+    pub fn vertices(
+        &self,
+        positions: &[[f64; 3]],
+        input: &InputIndex,
+        paths: &PathContext,
+        files: &dyn SelectionFiles,
+    ) -> Result<Vec<u32>, String> {
+        let picked = self.pick(positions, input, paths, files)?;
+        if matches!(self, Selection::Box { .. } | Selection::Sphere { .. } | Selection::Slab { .. }) {
+            return Ok(picked);
+        }
+        let mut kept: Vec<u32> = picked.iter().filter_map(|&v| input.kept_of_input[v as usize]).collect();
+        kept.sort_unstable();
+        if kept.is_empty() {
+            return Err(format!("selects only vertices that no face uses ({} of them)", picked.len()));
+        }
+        Ok(kept)
+    }
+
+    /// Shapes: mesh vertex ids; files and lists: input vertex ids.
+    fn pick(
+        &self,
+        input_positions: &[[f64; 3]],
+        input: &InputIndex,
+        paths: &PathContext,
+        files: &dyn SelectionFiles,
+    ) -> Result<Vec<u32>, String> {
+        let n_input = input.n_input();
+        let n = input_positions.len();
+        let (lo, hi) = meshes::geometry::bbox(input_positions);
+        let diagonal = norm(sub(hi, lo));
+        let to_box = |p: [f64; 3]| -> [f64; 3] {
+            std::array::from_fn(|k| if hi[k] > lo[k] { (p[k] - lo[k]) / (hi[k] - lo[k]) } else { 0.5 })
+        };
+        let from_box = |c: [f64; 3]| -> [f64; 3] { std::array::from_fn(|k| lo[k] + c[k] * (hi[k] - lo[k])) };
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        let picked: Vec<u32> = match self {
+            Selection::Sel { file, status } => {
+                let path = paths.resolve(file)?;
+                let codes = files.sel(&path)?;
+                let picked =
+                    (0..n_input as u32).filter(|&v| codes[v as usize] == *status).collect::<Vec<_>>();
+                if picked.is_empty() {
+                    return Err(format!("{}: no vertex has status {status}", path.display()));
+                }
+                picked
+            }
+            Selection::Dmat { file, id } => {
+                let path = paths.resolve(file)?;
+                let ids = files.dmat(&path)?;
+                let picked = (0..n_input as u32).filter(|&v| ids[v as usize] == *id).collect::<Vec<_>>();
+                if picked.is_empty() {
+                    let mut present: Vec<i64> = ids.clone();
+                    present.sort();
+                    present.dedup();
+                    return Err(format!(
+                        "{}: no vertex has region id {id} (ids present: {present:?})",
+                        path.display()
+                    ));
+                }
+                picked
+            }
+            Selection::Vertices(list) => checked_ids(list.clone(), n_input, "select.vertices")?,
+            Selection::VertexFile(file) => {
+                let path = paths.resolve(file)?;
+                checked_ids(files.index_list(&path)?, n_input, &path.display().to_string())?
+            }
+            Selection::Box { min, max } => {
+                if !(finite(min) && finite(max)) || (0..3).any(|k| min[k] > max[k]) {
+                    return Err(format!("box: min {min:?} must be finite and <= max {max:?}"));
+                }
+                let picked = (0..n as u32)
+                    .filter(|&v| {
+                        let c = to_box(input_positions[v as usize]);
+                        (0..3).all(|k| c[k] >= min[k] && c[k] <= max[k])
+                    })
+                    .collect::<Vec<_>>();
+                if picked.is_empty() {
+                    return Err(format!(
+                        "box {min:?}..{max:?} (bbox coordinates, [0, 1] spans the mesh) holds no vertex"
+                    ));
+                }
+                picked
+            }
+            Selection::Sphere { center, radius } => {
+                if !(finite(center) && radius.is_finite() && *radius > 0.0) {
+                    return Err(format!("sphere: center {center:?} finite and radius {radius} > 0 needed"));
+                }
+                let c = from_box(*center);
+                let picked = (0..n as u32)
+                    .filter(|&v| norm(sub(input_positions[v as usize], c)) <= radius * diagonal)
+                    .collect::<Vec<_>>();
+                if picked.is_empty() {
+                    return Err(format!(
+                        "sphere at {center:?} (bbox coordinates) with radius {radius} x diagonal holds no vertex"
+                    ));
+                }
+                picked
+            }
+            Selection::Slab { axis, from, to } => {
+                if !(from.is_finite() && to.is_finite() && from <= to) {
+                    return Err(format!("slab: from {from} must be finite and <= to {to}"));
+                }
+                let k = axis.index();
+                let picked = (0..n as u32)
+                    .filter(|&v| {
+                        let c = to_box(input_positions[v as usize])[k];
+                        c >= *from && c <= *to
+                    })
+                    .collect::<Vec<_>>();
+                if picked.is_empty() {
+                    return Err(format!(
+                        "slab {axis:?} {from}..{to} (bbox coordinates, [0, 1] spans the mesh) holds no vertex"
+                    ));
+                }
+                picked
+            }
+        };
+        Ok(picked)
+    }
+}
+
+/// `ids` sorted and deduplicated, each below `n`; `what` names the source in errors.
+fn checked_ids(mut ids: Vec<u32>, n: usize, what: &str) -> Result<Vec<u32>, String> {
+    if let Some(bad) = ids.iter().find(|&&v| v as usize >= n) {
+        return Err(format!("{what}: vertex {bad} is out of range (the mesh has {n} vertices)"));
+    }
+    if ids.is_empty() {
+        return Err(format!("{what}: lists no vertex"));
+    }
+    ids.sort_unstable();
+    ids.dedup();
+    Ok(ids)
+}
+
+/// The centroid of the vertices `ids` of `mesh`.
+pub fn centroid(mesh: &TriMesh, ids: &[u32]) -> [f64; 3] {
+    let p = mesh.positions();
+    let n = ids.len().max(1) as f64;
+    std::array::from_fn(|k| ids.iter().map(|&v| p[v as usize][k]).sum::<f64>() / n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct NoFiles;
+    impl SelectionFiles for NoFiles {
+        fn sel(&self, _: &Path) -> Result<Vec<u8>, String> {
+            Ok(vec![0, 2, 1, 2])
+        }
+        fn dmat(&self, _: &Path) -> Result<Vec<i64>, String> {
+            Ok(vec![-1, 0, 0, 1])
+        }
+        fn index_list(&self, _: &Path) -> Result<Vec<u32>, String> {
+            Ok(vec![3, 1, 3])
+        }
+    }
+
+    /// Four vertices on the x axis at 0, 1, 2, 3 (bbox x coordinates 0, 1/3, 2/3, 1).
+    fn line() -> Vec<[f64; 3]> {
+        (0..4).map(|i| [i as f64, 0.0, 0.0]).collect()
+    }
+
+    fn pick(s: &Selection, input: &InputIndex) -> Result<Vec<u32>, String> {
+        s.vertices(
+            &line(),
+            input,
+            &PathContext { base: "/data".into(), stem: Some("knight".into()) },
+            &NoFiles,
+        )
+    }
+
+    #[test]
+    fn shapes_pick_by_bounding_box_coordinates() {
+        let all = InputIndex::identity(4);
+        let slab = Selection::Slab { axis: Axis::X, from: 0.0, to: 0.4 };
+        assert_eq!(pick(&slab, &all).unwrap(), vec![0, 1]);
+        let boxed = Selection::Box { min: [0.5, 0.0, 0.0], max: [1.0, 1.0, 1.0] };
+        assert_eq!(pick(&boxed, &all).unwrap(), vec![2, 3]);
+        // Radius 0.34 of the diagonal (3) around x = 3: vertices 2 and 3.
+        let sphere = Selection::Sphere { center: [1.0, 0.5, 0.5], radius: 0.34 };
+        assert_eq!(pick(&sphere, &all).unwrap(), vec![2, 3]);
+        let outside = Selection::Box { min: [2.0, 0.0, 0.0], max: [3.0, 1.0, 1.0] };
+        assert!(pick(&outside, &all).unwrap_err().contains("holds no vertex"));
+        let inverted = Selection::Slab { axis: Axis::X, from: 0.5, to: 0.1 };
+        assert!(pick(&inverted, &all).unwrap_err().contains("<= to"));
+    }
+
+    #[test]
+    fn file_selections_index_the_input_and_map_through_dropped_vertices() {
+        // Input vertex 1 was dropped; input 2 and 3 are mesh vertices 1 and 2 (mesh vertex 3 unused here).
+        let input = InputIndex { kept_of_input: vec![Some(0), None, Some(1), Some(2)] };
+        let handle = Selection::Sel { file: "x.sel".into(), status: 2 };
+        assert_eq!(pick(&handle, &input).unwrap(), vec![2], "input 1 dropped, input 3 is mesh 2");
+        let region = Selection::Dmat { file: "x.dmat".into(), id: 0 };
+        assert_eq!(pick(&region, &input).unwrap(), vec![1]);
+        let missing = Selection::Dmat { file: "x.dmat".into(), id: 7 };
+        assert!(pick(&missing, &input).unwrap_err().contains("ids present: [-1, 0, 1]"));
+        assert_eq!(pick(&Selection::VertexFile("ids.txt".into()), &input).unwrap(), vec![2]);
+        let only_dropped = Selection::Vertices(vec![1]);
+        assert!(pick(&only_dropped, &input).unwrap_err().contains("no face uses"));
+    }
+
+    #[test]
+    fn paths_resolve_against_the_scenario_with_variables_and_stems() {
+        let ctx = PathContext { base: "/configs/real".into(), stem: Some("knight".into()) };
+        assert_eq!(
+            ctx.resolve("{stem}-selection.dmat").unwrap(),
+            PathBuf::from("/configs/real/knight-selection.dmat")
+        );
+        assert_eq!(ctx.resolve("/abs/x.off").unwrap(), PathBuf::from("/abs/x.off"));
+        std::env::set_var("DEFORMBENCH_TEST_SELECTION_DIR", "/somewhere");
+        assert_eq!(
+            ctx.resolve("${DEFORMBENCH_TEST_SELECTION_DIR}/a.off").unwrap(),
+            PathBuf::from("/somewhere/a.off")
+        );
+        let e = ctx.resolve("${DEFORMBENCH_TEST_UNSET_VARIABLE}/a.off").unwrap_err();
+        assert!(e.contains("DEFORMBENCH_TEST_UNSET_VARIABLE"), "{e}");
+        let no_stem = PathContext { base: ".".into(), stem: None };
+        assert!(no_stem.resolve("{stem}.sel").unwrap_err().contains("needs a mesh file"));
+    }
+}
