@@ -90,6 +90,26 @@ impl Camera {
         Camera::framing(VIEW_FROM, VIEW_UP, lo, hi, aspect)
     }
 
+    /// [`Camera::for_shapes`] for a scene standing on `up` (0: x, 1: y, 2: z) instead of `z`: the same
+    /// view, turned by the cyclic permutation of the axes that takes `z` to `up` (a rotation, so the
+    /// image is not mirrored).
+    pub fn for_shapes_up<'a>(
+        shapes: impl IntoIterator<Item = &'a [[f64; 3]]>,
+        aspect: f64,
+        up: usize,
+    ) -> Camera {
+        let (lo, hi) = union_bbox(shapes).unwrap_or(([0.0; 3], [1.0; 3]));
+        let turn = |v: [f64; 3]| -> [f64; 3] {
+            // z-up coordinates (a, b, c) as world coordinates with `up` in the role of z.
+            match up {
+                0 => [v[2], v[0], v[1]],
+                1 => [v[1], v[2], v[0]],
+                _ => v,
+            }
+        };
+        Camera::framing(turn(VIEW_FROM), turn(VIEW_UP), lo, hi, aspect)
+    }
+
     /// Unit direction from the scene towards the eye (the headlight's direction).
     pub fn toward_eye(&self) -> [f64; 3] {
         self.toward_eye

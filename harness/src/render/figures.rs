@@ -224,7 +224,9 @@ fn render_row(row: &Row) -> RenderedRow {
     let mesh = &row.scenario.mesh;
     let (rest, triangles) = (mesh.positions(), mesh.triangles());
     let targets = frame_targets(row.scenario);
-    let camera = Camera::for_shapes(std::iter::once(rest).chain(targets.iter().map(Vec::as_slice)), 1.0);
+    let up = row.scenario.spec.up.map_or(2, |a| a.index());
+    let camera =
+        Camera::for_shapes_up(std::iter::once(rest).chain(targets.iter().map(Vec::as_slice)), 1.0, up);
     let roles = vertex_roles(row.scenario);
     let draw = |positions: &[[f64; 3]], paints: &[Paint]| {
         render(&camera, positions, triangles, CELL_SIZE, CELL_SIZE, paints)
@@ -272,7 +274,7 @@ fn grid_image(
     let width = 2 * PAD + label_w + n_cols * CELL_SIZE;
     let mut notes = vec![
         format!(
-            "Orthographic view from ({}, {}, {}), z up; one camera per row, framing the rest shape and the \
+            "Orthographic view from ({}, {}, {}), z up (axes turned for a scenario with another `up`); one camera per row, framing the rest shape and the \
              handle targets. A result that leaves that frame is drawn clipped and its cell marked \"clipped\"; \
              a suspect case is marked \"suspect\" (reasons in the results table). Headlight Lambert shading.",
             VIEW_FROM[0], VIEW_FROM[1], VIEW_FROM[2]

@@ -83,6 +83,9 @@ pub struct ScenarioSpec {
     /// A glob of mesh files: one scenario `<name>-<stem>` per match, in sorted order.
     #[serde(default)]
     pub meshes: Option<String>,
+    /// The axis the mesh stands on, drawn upwards in the figures (default `z`, the survey's).
+    #[serde(default)]
+    pub up: Option<selection::Axis>,
     /// The regions of the first edit (default for `survey`/`procedural`: the survey selection).
     #[serde(default)]
     pub regions: Vec<RegionSpec>,

@@ -47,7 +47,7 @@ pub enum Axis {
 }
 
 impl Axis {
-    fn index(self) -> usize {
+    pub fn index(self) -> usize {
         self as usize
     }
 }
