@@ -568,6 +568,11 @@ fn timeless(case: &serde_json::Value) -> serde_json::Value {
     c
 }
 
+/// `harness all --quiet` with the configs directory `configs`, writing to `reports`.
+fn all_with(configs: &Path, reports: &Path) -> anyhow::Result<std::process::ExitCode> {
+    run(&["all", "--quiet", "--configs", configs.to_str().unwrap(), "--reports", reports.to_str().unwrap()])
+}
+
 fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
         .unwrap()
@@ -695,15 +700,7 @@ fn the_same_mesh_in_off_ply_and_glb_gives_the_same_results() {
     };
     let configs = configs_with(&[scenario("off"), scenario("ply"), scenario("glb")]);
     let reports = tempfile::tempdir().unwrap();
-    let args = [
-        "all",
-        "--quiet",
-        "--configs",
-        configs.path().to_str().unwrap(),
-        "--reports",
-        reports.path().to_str().unwrap(),
-    ];
-    assert_eq!(run(&args).unwrap(), std::process::ExitCode::SUCCESS);
+    assert_eq!(all_with(configs.path(), reports.path()).unwrap(), std::process::ExitCode::SUCCESS);
     let json = read_json(&reports.path().join("results.json"));
     let cases = json["cases"].as_array().unwrap();
     assert_eq!(cases.len(), 9);
@@ -743,14 +740,7 @@ fn expect_mesh_scenario_error(regions: &str, mesh_line: &str, prepare: impl Fn(&
     let reports = root.path().join("reports");
     std::fs::create_dir(&reports).unwrap();
     std::fs::write(reports.join("sentinel.txt"), "untouched").unwrap();
-    let result = run(&[
-        "all",
-        "--quiet",
-        "--configs",
-        configs.path().to_str().unwrap(),
-        "--reports",
-        reports.to_str().unwrap(),
-    ]);
+    let result = all_with(configs.path(), &reports);
     let message = format!("{:#}", result.expect_err("bad input must be an error"));
     for needle in needles {
         assert!(message.contains(needle), "error {message:?} does not mention {needle:?}");
@@ -851,15 +841,7 @@ fn unreferenced_vertices_are_dropped_and_results_keep_the_input_order() {
         format!("name = \"stray\"\nmesh = \"{}\"\nmethods = [\"arap\"]\n{FIXED_AND_HANDLE}", path.display());
     let configs = configs_with(&[("stray.toml".to_string(), text)]);
     let reports = root.path().join("reports");
-    let args = [
-        "all",
-        "--quiet",
-        "--configs",
-        configs.path().to_str().unwrap(),
-        "--reports",
-        reports.to_str().unwrap(),
-    ];
-    assert_eq!(run(&args).unwrap(), std::process::ExitCode::SUCCESS);
+    assert_eq!(all_with(configs.path(), reports).unwrap(), std::process::ExitCode::SUCCESS);
     let result = meshes::io::read_mesh(reports.join("meshes/stray-arap.off")).unwrap();
     assert_eq!(result.n_vertices(), p.len(), "written in the input's vertex order, the stray included");
     assert_eq!(result.positions()[0], [5.0, 5.0, 5.0], "the stray stays where it was");

@@ -1,7 +1,7 @@
 //! Every kind of bad input yields the right error variant, and a message that names the file and the
 //! offending line or element.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use meshes::io::{
     read_dmat, read_dmat_column, read_gltf, read_index_list, read_mesh, read_obj, read_off, read_selection,
@@ -9,17 +9,8 @@ use meshes::io::{
 };
 use meshes::MeshError;
 
-struct Case {
-    _dir: tempfile::TempDir,
-    path: PathBuf,
-}
-
-fn file(name: &str, content: impl AsRef<[u8]>) -> Case {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join(name);
-    std::fs::write(&path, content).unwrap();
-    Case { _dir: dir, path }
-}
+mod fixture;
+use fixture::file;
 
 /// The error must be `InFile` for `path`, its message must start with the path and contain every
 /// piece of `needles`; returns the inner error.

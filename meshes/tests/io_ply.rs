@@ -1,7 +1,7 @@
 //! PLY: the three encodings, property types and names, polygon triangulation, bad input, and the
 //! same mesh through OFF, PLY and GLB.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use meshes::io::{
     parse_ply, read_gltf, read_mesh, read_off, read_ply, write_glb, write_mesh, write_off, write_ply,
@@ -32,17 +32,8 @@ fn awkward_mesh() -> TriMesh {
     TriMesh::new(positions, vec![[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]]).unwrap()
 }
 
-struct Case {
-    _dir: tempfile::TempDir,
-    path: PathBuf,
-}
-
-fn file(name: &str, content: impl AsRef<[u8]>) -> Case {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join(name);
-    std::fs::write(&path, content).unwrap();
-    Case { _dir: dir, path }
-}
+mod fixture;
+use fixture::file;
 
 /// The error is `InFile` for `path` and its message names the file and every needle; returns the
 /// inner error.
