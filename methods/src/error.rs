@@ -26,6 +26,8 @@ pub enum MethodError {
     Eigen(crate::spectral::EigenError),
     #[error("`{method}` produced a non-finite position at vertex {vertex} in iteration {iteration}")]
     NonFinite { method: &'static str, vertex: usize, iteration: usize },
+    #[error("`{method}` diverged: iteration {iteration} moved a vertex {step:.3e} bounding-box diagonals")]
+    Diverged { method: &'static str, iteration: usize, step: f64 },
 }
 
 impl From<SolverError> for MethodError {

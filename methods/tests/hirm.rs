@@ -241,3 +241,29 @@ fn handle_update_adds_the_constraint_term_to_t1() {
         }
     }
 }
+
+/// Section 5's remedy: at least `min_fields` fields at precompute, and more when a handle set has
+/// more regions than `fields_per_region x` the model's fields allow; the growth is its own phase.
+#[test]
+fn fields_grow_to_the_handle_count_and_at_least_min_fields_are_kept() {
+    let (mesh, handles) = bar();
+    let params = HirmParams { min_fields: 3, fields_per_region: 3.0, max_fields: 8, ..HirmParams::default() };
+    let mut hirm = Hirm::new(params).unwrap();
+    hirm.precompute(&mesh).unwrap();
+    let n_field = |h: &Hirm| h.model_statistics().iter().find(|(k, _)| *k == "n_field").unwrap().1;
+    let selected = n_field(&hirm);
+    assert!((3.0..6.0).contains(&selected), "min_fields 3, and the bar selects 5 by phi: {selected}");
+    // Two regions x 3 = 6 fields: grown at this bind.
+    hirm.bind_handles(&handles).unwrap();
+    assert_eq!(n_field(&hirm), 6.0);
+    assert!(hirm.phase_timings().iter().any(|(k, _)| *k == "t_g_field_growth"), "{:?}", hirm.phase_timings());
+    let t = targets(&handles, &hirm.positions(), [0.0, 0.0, 0.1]);
+    let summary = hirm.solve(&t, &mut NoObserver).unwrap();
+    assert!(summary.converged, "{summary:?}");
+    // Five regions would need 15 fields: capped at max_fields = 8.
+    let n = mesh.n_vertices() as u32;
+    let regions: Vec<HandleRegion> =
+        (0..5).map(|r| HandleRegion { name: format!("r{r}"), vertices: vec![r * (n / 5)] }).collect();
+    hirm.bind_handles(&HandleSet::new(regions, mesh.n_vertices()).unwrap()).unwrap();
+    assert_eq!(n_field(&hirm), 8.0);
+}

@@ -25,6 +25,22 @@
 //! - `bind_handles` waits for a background precompute still running; the wait is reported
 //!   separately (`bind_background_wait`) from the handle update `t_h`.
 //! - The step size is the largest displacement of the vertices of the sampled triangles.
+//! - Field count and isolines per field (section 5, Fig. 5: few propagation fields shear when handles
+//!   are close, more fields cure it). A region moves apart from the others only where some field
+//!   separates them: with the paper's selection (phi = 3.5: 6 fields on the cactus, 5 on the bar)
+//!   the 10 close patches of `cactus-handles` tore the arms and folded them through the body
+//!   (E_theta 24.8 deg, 0.65% folded edges) and the cactus edit stalled at the iteration cap. So
+//!   every model has at least `min_fields = 10` fields (the next eigenvectors when fewer score below
+//!   phi), with `n_iso = 12` isolines each: 120 isolines for 10 fields, the reduced size the paper's
+//!   6 x 20 had on the cactus, so `t_h` and the iteration cost stay where they were. Measured on the
+//!   survey (E_theta, iterations; paper's selection -> this): cactus-handles 24.8 deg torn -> 8.3 deg
+//!   (isolines 6.2), cactus 6.29 deg in 500 (cap) -> 5.78 deg in 26, cactus-incremental 7.00 -> 6.35,
+//!   plane 6.11 -> 5.39; bar 9.62 -> 10.04 and cylinder 9.24 -> 10.30 pay for it.
+//! - A handle set of more regions than that gets `fields_per_region x n` fields (capped by
+//!   `max_fields`): the fields of the rest mesh are recomputed with the next eigenvectors and the
+//!   handle-independent system rebuilt on the current shape, synchronously (phase
+//!   `t_g_field_growth`, reported apart from the handle update `t_h`); later handle sets of that
+//!   size or smaller cost only `t_h` again.
 
 pub mod background;
 pub mod propagation_fields;
@@ -57,7 +73,9 @@ pub struct HirmParams {
     pub threshold: f64,
     /// Upper bound on the number of fields (the paper's meshes select 3 to 14).
     pub max_fields: usize,
-    /// `n_iso`, isolines per field (the paper: 20).
+    /// Lower bound on the number of fields, whatever their scores (module docs; the paper has none).
+    pub min_fields: usize,
+    /// `n_iso`, isolines per field (the paper: 20; here 12, see the module docs).
     pub isolines: usize,
     /// Upper bound on the sampled crossed triangles of all isolines (the paper's Table 1 `n_t1`:
     /// 600 to 3000).
@@ -66,6 +84,9 @@ pub struct HirmParams {
     pub mu: f64,
     /// Soft handle-constraint weight `omega`.
     pub omega: f64,
+    /// A handle set of `n` regions needs at least `fields_per_region x n` propagation fields (module
+    /// docs); 0 turns the growth off (the paper's fixed `phi` selection).
+    pub fields_per_region: f64,
     /// Iteration limit per solve.
     pub max_iterations: usize,
     /// Converged when the step falls below `tolerance x bbox diagonal`.
@@ -79,10 +100,12 @@ impl Default for HirmParams {
         Self {
             threshold: 3.5,
             max_fields: 20,
-            isolines: 20,
+            min_fields: 10,
+            isolines: 12,
             max_crossed_triangles: 1200,
             mu: 0.01,
             omega: 1000.0,
+            fields_per_region: 1.0,
             max_iterations: 500,
             tolerance: 1e-5,
             seed: 0x5eed,
@@ -92,6 +115,8 @@ impl Default for HirmParams {
 
 /// Rest-mesh data kept for the whole edit session.
 struct Rest {
+    /// `#V x 3` rest positions (the fields are the rest mesh's, also when they grow).
+    positions: Vec<[f64; 3]>,
     inputs: Arc<SystemInputs>,
     scores: Vec<f64>,
     capped: bool,
@@ -137,6 +162,7 @@ impl Hirm {
             || params.max_crossed_triangles == 0
             || !(params.mu >= 0.0)
             || !(params.omega > 0.0)
+            || !(params.fields_per_region >= 0.0 && params.fields_per_region.is_finite())
             || params.max_iterations == 0
             || !(params.tolerance >= 0.0)
         {
@@ -144,7 +170,8 @@ impl Hirm {
                 method: "hirm",
                 message:
                     "threshold must be > 1, max_fields >= 1, isolines >= 2, max_crossed_triangles >= 1, \
-                          mu >= 0, omega > 0, max_iterations >= 1, tolerance >= 0"
+                          mu >= 0, omega > 0, fields_per_region >= 0 and finite, max_iterations >= 1, \
+                          tolerance >= 0"
                         .into(),
             });
         }
@@ -191,6 +218,46 @@ impl Hirm {
         Ok(Some(ready))
     }
 
+    /// The number of fields a handle set of `regions` regions needs (module docs).
+    fn fields_needed(&self, regions: usize) -> usize {
+        ((self.params.fields_per_region * regions as f64).ceil() as usize).min(self.params.max_fields)
+    }
+
+    /// Recompute the rest mesh's propagation fields with at least `count` of them and the
+    /// handle-independent system on the current shape (waiting for a background worker first).
+    fn grow_fields(&mut self, count: usize) -> Result<(), MethodError> {
+        let start = Instant::now();
+        if let Some(Precomputed::Running(worker)) = self.precomputed.take() {
+            worker.finish()?;
+        }
+        let rest = self.rest.as_mut().expect("precomputed");
+        let fields = propagation_fields::propagation_fields_at_least(
+            &rest.positions,
+            &rest.inputs.triangles,
+            &rest.inputs.laplacian,
+            self.params.threshold,
+            count,
+            self.params.max_fields,
+            self.params.seed,
+        )?;
+        let inputs = Arc::new(SystemInputs {
+            triangles: rest.inputs.triangles.clone(),
+            fields: fields.fields,
+            weights: fields.weights,
+            laplacian: rest.inputs.laplacian.clone(),
+            isolines: self.params.isolines,
+            max_crossed_triangles: self.params.max_crossed_triangles,
+            mu: self.params.mu,
+        });
+        let model = handle_independent_model(&self.current, &inputs);
+        rest.inputs = inputs;
+        rest.scores = fields.scores;
+        rest.capped = fields.capped;
+        self.precomputed = Some(Precomputed::Ready(Arc::new(model)));
+        self.set_timing("t_g_field_growth", start.elapsed().as_secs_f64());
+        Ok(())
+    }
+
     fn set_timing(&mut self, name: &'static str, seconds: f64) {
         self.timings.retain(|(k, _)| *k != name);
         self.timings.push((name, seconds));
@@ -212,11 +279,12 @@ impl DeformationMethod for Hirm {
         }
         let start = Instant::now();
         let laplacian = cotan_laplacian(rest.positions(), rest.triangles());
-        let fields = propagation_fields(
+        let fields = propagation_fields::propagation_fields_at_least(
             rest.positions(),
             rest.triangles(),
             &laplacian,
             self.params.threshold,
+            self.params.min_fields,
             self.params.max_fields,
             self.params.seed,
         )?;
@@ -235,6 +303,7 @@ impl DeformationMethod for Hirm {
         self.set_timing("t_b_background_precompute", model.seconds);
         self.precomputed = Some(Precomputed::Ready(Arc::new(model)));
         self.rest = Some(Rest {
+            positions: rest.positions().to_vec(),
             inputs,
             scores: fields.scores,
             capped: fields.capped,
@@ -249,6 +318,10 @@ impl DeformationMethod for Hirm {
             return Err(MethodError::Phase { method: "hirm", phase: "bind_handles", missing: "precompute" });
         }
         handles.check_mesh_size(self.current.len())?;
+        let needed = self.fields_needed(handles.regions().len());
+        if self.rest.as_ref().is_some_and(|r| r.scores.len() < needed) {
+            self.grow_fields(needed)?;
+        }
         let wait = Instant::now();
         let independent = self.handle_independent()?.expect("precompute leaves a model or a worker");
         self.set_timing("bind_background_wait", wait.elapsed().as_secs_f64());

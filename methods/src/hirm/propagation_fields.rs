@@ -55,12 +55,28 @@ pub fn propagation_fields(
     max_fields: usize,
     seed: u64,
 ) -> Result<PropagationFields, MethodError> {
+    propagation_fields_at_least(positions, triangles, laplacian, threshold, 1, max_fields, seed)
+}
+
+/// [`propagation_fields`] with at least `min_fields` fields (capped by `max_fields` and the mesh
+/// size), the next eigenvectors in order when fewer score below `threshold`: the remedy of Wu et
+/// al.'s section 5 for handles too close for the selected fields to tell apart.
+pub fn propagation_fields_at_least(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    laplacian: &SparseColMat<usize, f64>,
+    threshold: f64,
+    min_fields: usize,
+    max_fields: usize,
+    seed: u64,
+) -> Result<PropagationFields, MethodError> {
     let n = positions.len();
     let mut stiffness = laplacian.clone();
     stiffness.val_mut().iter_mut().for_each(|v| *v = -*v);
     let mass = lumped_mass(positions, triangles, MassKind::Barycentric);
     let wanted = (max_fields + 1).min(n);
-    let mut count = 16.min(wanted);
+    let floor = (min_fields.min(max_fields) + 1).min(n);
+    let mut count = 16.max(floor).min(wanted);
     let pairs = loop {
         let mut options = EigenOptions::new(count);
         options.seed = seed;
@@ -71,13 +87,13 @@ pub fn propagation_fields(
                 pairs.values.get(1).copied().unwrap_or(f64::NAN)
             )))
         })?;
-        if selected + 1 < count || count == wanted {
+        if (selected + 1 < count && count >= floor) || count == wanted {
             break pairs;
         }
         count = (2 * count).min(wanted);
     };
     let available = select_fields(&pairs.values, threshold).expect("checked in the loop");
-    let n_field = available.min(max_fields);
+    let n_field = available.max(min_fields).min(max_fields).min(pairs.values.len() - 1);
     let lambda_2 = pairs.values[1];
     let scores = pairs.values[1..=n_field].iter().map(|l| (l / lambda_2).sqrt()).collect();
     let selected = pairs.vectors.as_ref().subcols(1, n_field);
