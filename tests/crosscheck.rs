@@ -1,11 +1,13 @@
 //! Cross-checks against libigl on the survey meshes (run by `scripts/test`, which installs the pinned
-//! Python packages): operators to 1e-10 relative, ARAP to RMS distance <= 1e-3 of the bbox diagonal.
+//! Python packages): operators (also the intrinsic Delaunay Laplacian, on the real meshes too when
+//! `$DEFORM_REAL_MESHES_DIR` is set) to 1e-10 relative, ARAP to RMS distance <= 1e-3 of the bbox
+//! diagonal.
 
 mod support;
 
 use std::collections::HashMap;
 
-use methods::operators::{cotan_laplacian, lumped_mass, MassKind};
+use methods::operators::{cotan_laplacian, lumped_mass, IntrinsicTriangulation, MassKind};
 use methods::NoObserver;
 use support::{igl_reference, python, read_rows, survey_case, survey_dir};
 
@@ -62,6 +64,47 @@ fn cotan_laplacian_and_mass_match_libigl() {
             println!("{name}: {kind:?} mass max relative error {err:.2e}");
             assert!(err <= 1e-10, "{name}: {kind:?} mass differs from igl::massmatrix by {err:e}");
         }
+    }
+}
+
+/// Our stored entries of `l` as a map.
+fn entry_map(l: &faer::sparse::SparseColMat<usize, f64>) -> HashMap<(usize, usize), f64> {
+    let (sym, val) = l.parts();
+    let mut map = HashMap::new();
+    for j in 0..sym.ncols() {
+        for idx in sym.col_range(j) {
+            *map.entry((sym.row_idx()[idx], j)).or_insert(0.0) += val[idx];
+        }
+    }
+    map
+}
+
+#[test]
+fn intrinsic_delaunay_laplacian_matches_libigl() {
+    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    let mut paths: Vec<std::path::PathBuf> = MESHES.iter().map(|n| dir.join(format!("{n}.off"))).collect();
+    // The real meshes only when named (scripts/test sets the variable).
+    if let Some(real) = std::env::var_os("DEFORM_REAL_MESHES_DIR").and_then(|_| support::real_meshes_dir()) {
+        paths.extend(["decimated-knight.off", "bunny.off"].map(|f| real.join(f)));
+    }
+    for mesh_path in paths {
+        let mesh = meshes::io::read_mesh(&mesh_path).unwrap();
+        let out = tempfile::tempdir().unwrap();
+        igl_reference(
+            &py,
+            &["intrinsic_delaunay", mesh_path.to_str().unwrap(), out.path().to_str().unwrap()],
+        );
+        let theirs: HashMap<(usize, usize), f64> =
+            read_rows(&out.path().join("intrinsic_delaunay_cotmatrix.txt"))
+                .into_iter()
+                .map(|r| ((r[0] as usize, r[1] as usize), r[2]))
+                .collect();
+        let t = IntrinsicTriangulation::delaunay(mesh.positions(), mesh.triangles()).unwrap();
+        let ours = entry_map(&t.cotan_laplacian());
+        let err = sparse_relative_error(&ours, &theirs);
+        let name = mesh_path.file_name().unwrap().to_string_lossy();
+        println!("{name}: {} flips, intrinsic_delaunay_cotmatrix max relative error {err:.2e}", t.flips());
+        assert!(err <= 1e-10, "{name}: intrinsic Delaunay Laplacian differs from libigl's by {err:e}");
     }
 }
 
@@ -127,7 +170,9 @@ impl ArapCase {
 
     /// Our `arap` after exactly `iterations` iterations (no early exit), from the rest shape.
     fn our_arap(&self, iterations: usize) -> Vec<[f64; 3]> {
-        let params: toml::Table = format!("max_iterations = {iterations}\ntolerance = 0.0").parse().unwrap();
+        // libigl's arap uses the mesh's cotangent weights.
+        let params: toml::Table =
+            format!("max_iterations = {iterations}\ntolerance = 0.0\nweights = \"cotan\"").parse().unwrap();
         let mut arap = methods::registry::create("arap", &params).unwrap();
         arap.precompute(&self.mesh).unwrap();
         arap.bind_handles(&self.handles).unwrap();

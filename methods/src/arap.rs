@@ -1,11 +1,30 @@
 //! `arap`: As-Rigid-As-Possible surface modeling (Sorkine & Alexa 2007), the suite's nonlinear reference.
 //!
 //! Energy (SA07 eq 3, "spokes"): `E(X) = sum_i sum_{j in N(i)} w_ij |(x_i - x_j) - R_i (p_i - p_j)|^2`
-//! with cotangent weights `w_ij = (cot a_ij + cot b_ij) / 2` (libigl's `cotmatrix` entries), handle
+//! with cotangent weights `w_ij = (cot a_ij + cot b_ij) / 2` (libigl's `cotmatrix` entries; see
+//! "Weights" below for the choice of triangulation), handle
 //! vertices as hard constraints, alternating
 //! - local step: `R_i` = closest rotation to `sum_j w_ij (x_i - x_j)(p_i - p_j)^T` (SA07 eq 5–6);
 //! - global step: `-L X = b`, `b_i = sum_j w_ij / 2 (R_i + R_j)(p_i - p_j)` (SA07 eq 8–9), constrained
 //!   rows eliminated.
+//!
+//! Weights (`weights`, [`LaplacianWeights`]; default `intrinsic_delaunay`). The energy's spokes are
+//! the vertex pairs the chosen Laplacian couples, with `w_ij = L_ij`, and the global-step matrix is
+//! that same `-L`:
+//! - `cotan` is SA07 as published (and libigl's `arap`); on obtuse triangles `w_ij < 0` makes the
+//!   energy reward stretching those spokes and the local step fit rotations to flipped spokes.
+//! - `clamped`: the mesh's spokes with negative weights set to 0.
+//! - `intrinsic_delaunay`: the spokes are the edges of the intrinsic Delaunay triangulation, all
+//!   `w_ij >= 0`. Most are mesh edges; a flipped edge joins the two far corners of a pair of mesh
+//!   triangles, and its spoke is the chord `p_i - p_j` between them (the rest vector whose rigid
+//!   motion the energy measures; a rigid motion of the whole mesh still has zero energy). The
+//!   alternative — mesh-edge spokes weighted by the intrinsic `L_ij` of their vertex pair, 0 for
+//!   flipped-away edges — would leave `b(R = I) != -L P`, so the rest shape would not be a fixed
+//!   point of its own global step. With spokes = `L`'s pattern, `b(R = I) = -L P` exactly, and with
+//!   non-negative weights the rest covariance `sum_j w_ij e_ij e_ij^T` is positive semi-definite, so
+//!   the local step returns `R = I` at rest (identity targets give zero motion; tested in
+//!   `methods/tests/weights.rs`). Parallel intrinsic edges are summed in `L`; a self-edge has
+//!   `e_ii = 0` and drops out.
 //!
 //! The initial guess is the current shape (the rest shape after `precompute`), as libigl's `arap_solve`
 //! with `U = V`, so the two can be compared iteration for iteration.
@@ -26,7 +45,7 @@ use serde::Deserialize;
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets, FREE};
 use crate::method::{finish_iteration, DeformationMethod, IterationObserver, SolveSummary};
-use crate::operators::cotan_laplacian;
+use crate::operators::{laplacian, LaplacianWeights};
 use crate::rotation_fit::{closest_rotation_warm, Mat3};
 use crate::sparse_cholesky::SparseCholesky;
 
@@ -38,11 +57,13 @@ pub struct ArapParams {
     pub max_iterations: usize,
     /// Converged when the largest vertex step falls below `tolerance x bbox diagonal`.
     pub tolerance: f64,
+    /// Spokes, weights and global-step matrix (see the module documentation, "Weights").
+    pub weights: LaplacianWeights,
 }
 
 impl Default for ArapParams {
     fn default() -> Self {
-        Self { max_iterations: 1000, tolerance: 1e-5 }
+        Self { max_iterations: 1000, tolerance: 1e-5, weights: LaplacianWeights::IntrinsicDelaunay }
     }
 }
 
@@ -175,7 +196,7 @@ impl DeformationMethod for Arap {
 
     fn precompute(&mut self, rest: &TriMesh) -> Result<(), MethodError> {
         meshes::Topology::new(rest)?;
-        let laplacian = cotan_laplacian(rest.positions(), rest.triangles());
+        let laplacian = laplacian(self.params.weights, rest.positions(), rest.triangles())?;
         let n = rest.n_vertices();
         let (symbolic, values) = laplacian.parts();
         let mut offsets = Vec::with_capacity(n + 1);
@@ -183,7 +204,7 @@ impl DeformationMethod for Arap {
         let mut weights = Vec::new();
         let mut rest_edges = Vec::new();
         offsets.push(0);
-        // L is symmetric, so column i lists row i's neighbours.
+        // L is symmetric, so column i lists row i's neighbours: the spokes of vertex i.
         for i in 0..n {
             for idx in symbolic.col_range(i) {
                 let j = symbolic.row_idx()[idx];

@@ -22,12 +22,20 @@ pub enum MethodError {
     Solver(SolverError),
     #[error("`{method}`: the background precompute thread panicked")]
     Background { method: &'static str },
+    #[error("intrinsic Delaunay triangulation: {0}")]
+    IntrinsicDelaunay(crate::operators::IntrinsicDelaunayError),
     #[error("eigensolver: {0}")]
     Eigen(crate::spectral::EigenError),
     #[error("`{method}` produced a non-finite position at vertex {vertex} in iteration {iteration}")]
     NonFinite { method: &'static str, vertex: usize, iteration: usize },
     #[error("`{method}` diverged: iteration {iteration} moved a vertex {step:.3e} bounding-box diagonals")]
     Diverged { method: &'static str, iteration: usize, step: f64 },
+}
+
+impl From<crate::operators::IntrinsicDelaunayError> for MethodError {
+    fn from(e: crate::operators::IntrinsicDelaunayError) -> Self {
+        MethodError::IntrinsicDelaunay(e)
+    }
 }
 
 impl From<SolverError> for MethodError {

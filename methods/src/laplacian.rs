@@ -6,8 +6,11 @@
 //! factored once per handle set.
 //!
 //! Decisions the paper leaves open (see also the tests):
-//! - `L` is the cotangent Laplacian without mass normalization (libigl `cotmatrix`); eq 1 is
-//!   invariant to the sign of `L`.
+//! - `L` is a cotangent Laplacian without mass normalization (libigl `cotmatrix`); eq 1 is
+//!   invariant to the sign of `L`. The weights (`weights`, default `intrinsic_delaunay`) enter
+//!   everything `L` does: the rest coordinates `delta = L X_rest`, the normal matrix `L^T L` and the
+//!   right-hand side `L^T delta(X)`; the rest shape stays a fixed point for any weights since both
+//!   sides use the same `L`.
 //! - `delta(X)` update: the rest Laplacian coordinates `delta_i = (L X_rest)_i` are stored in a local
 //!   frame per vertex and re-expressed in the frame of the current surface each iteration
 //!   ([`crate::laplacian_coordinates`]) — the rotation-invariant encoding of Lipman et al. 2005, used
@@ -32,7 +35,7 @@ use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
 use crate::laplacian_coordinates::RotationInvariantCoordinates;
 use crate::method::{finish_iteration, DeformationMethod, IterationObserver, SolveSummary};
-use crate::operators::cotan_laplacian;
+use crate::operators::{laplacian, LaplacianWeights};
 use crate::sparse_cholesky::{add_to_diagonal, SparseCholesky};
 
 /// Parameters of [`LaplacianEditing`] (configs/methods.toml, section `[laplacian]`).
@@ -45,11 +48,18 @@ pub struct LaplacianParams {
     pub max_iterations: usize,
     /// Converged when the largest vertex step falls below `tolerance x bbox diagonal`.
     pub tolerance: f64,
+    /// Weights of `L` (see the module documentation).
+    pub weights: LaplacianWeights,
 }
 
 impl Default for LaplacianParams {
     fn default() -> Self {
-        Self { omega: 1000.0, max_iterations: 2000, tolerance: 1e-5 }
+        Self {
+            omega: 1000.0,
+            max_iterations: 2000,
+            tolerance: 1e-5,
+            weights: LaplacianWeights::IntrinsicDelaunay,
+        }
     }
 }
 
@@ -115,7 +125,7 @@ impl DeformationMethod for LaplacianEditing {
         let topology = Topology::new(rest_mesh)?;
         let positions = rest_mesh.positions();
         let n = rest_mesh.n_vertices();
-        let laplacian = cotan_laplacian(positions, rest_mesh.triangles());
+        let laplacian = laplacian(self.params.weights, positions, rest_mesh.triangles())?;
         // L is symmetric, so L^T L = L L. Rebuilt from triplets to get sorted columns.
         let product = sparse_sparse_matmul(laplacian.as_ref(), laplacian.as_ref(), 1.0, Par::Seq)
             .map_err(|e| MethodError::Solver(crate::sparse_cholesky::SolverError::Faer(format!("{e:?}"))))?;

@@ -30,7 +30,7 @@ pub const METHODS: &[MethodEntry] = &[
     },
     MethodEntry {
         name: "arap",
-        summary: "As-Rigid-As-Possible surface modeling (Sorkine & Alexa 2007), cotangent weights, hard constraints",
+        summary: "As-Rigid-As-Possible surface modeling (Sorkine & Alexa 2007), cotangent weights (intrinsic Delaunay by default), hard constraints",
         create: |p| Ok(Box::new(Arap::new(parse("arap", p)?)?)),
     },
     MethodEntry {

@@ -17,6 +17,10 @@ operators MESH OUT_DIR
     OUT_DIR/mass_voronoi.txt     diagonal of igl.massmatrix(V, F, VORONOI), one value per line.
     OUT_DIR/mass_barycentric.txt diagonal of igl.massmatrix(V, F, BARYCENTRIC), one value per line.
 
+intrinsic_delaunay MESH OUT_DIR
+    OUT_DIR/intrinsic_delaunay_cotmatrix.txt  L of igl.intrinsic_delaunay_cotmatrix(V, F) as COO
+                                 triplets, in the format of `operators`' cotmatrix.txt.
+
 arap MESH CONSTRAINTS ITERATIONS OUT
     CONSTRAINTS: one line per constrained vertex, `index x y z` (target position); blank lines
     and lines starting with '#' are ignored. Runs libigl ARAP with the SPOKES energy, dim 3,
@@ -153,6 +157,23 @@ def cmd_operators(args):
                  mass_diagonal(V, F, igl.MASSMATRIX_TYPE_VORONOI))
     write_matrix(os.path.join(args.out_dir, "mass_barycentric.txt"),
                  mass_diagonal(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC))
+
+
+def write_coo(path, L):
+    """COO triplets of a sparse matrix, as `operators` writes cotmatrix.txt."""
+    L = L.tocoo()
+    L.sum_duplicates()
+    keep = L.data != 0.0
+    with open(path, "w") as fh:
+        for i, j, v in zip(L.row[keep].tolist(), L.col[keep].tolist(), L.data[keep].tolist()):
+            fh.write("%d %d %.17g\n" % (i, j, v))
+
+
+def cmd_intrinsic_delaunay(args):
+    V, F = read_mesh(args.mesh)
+    ensure_dir(args.out_dir)
+    L, _l_intrinsic, _F_intrinsic = igl.intrinsic_delaunay_cotmatrix(V, F)
+    write_coo(os.path.join(args.out_dir, "intrinsic_delaunay_cotmatrix.txt"), L)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -312,6 +333,11 @@ def build_parser():
     s.add_argument("mesh")
     s.add_argument("out_dir")
     s.set_defaults(func=cmd_operators)
+
+    s = sub.add_parser("intrinsic_delaunay", help="igl.intrinsic_delaunay_cotmatrix")
+    s.add_argument("mesh")
+    s.add_argument("out_dir")
+    s.set_defaults(func=cmd_intrinsic_delaunay)
 
     s = sub.add_parser("arap", help="libigl ARAP (SPOKES) deformation")
     s.add_argument("mesh")

@@ -21,6 +21,10 @@
 //!   deformation system is set for the new handles based on the most recently edited result",
 //!   section 5); from the rest shape that is the rest mesh. `L` is the rest mesh's cotangent
 //!   Laplacian; `delta_bar = L X_base`.
+//! - Weights of `L` (`weights`, default `intrinsic_delaunay`): they enter the harmonic fields
+//!   (`L phi = 0`; with non-negative weights the maximum principle keeps them in `[0, 1]`, so the
+//!   isolines are well defined), the reduced system `W_x^T L^T L W_x`, its right-hand side
+//!   `W_x^T L^T W_delta` and `delta_bar = L X_base`.
 //! - Isoline sets: with two handles one set, on the field of the first handle (section 4.1); with
 //!   one handle the model is a single rigid transform and is refused (a handle set needs a second,
 //!   e.g. fixed, region). With three or more, one set per handle, blended by `phi_i` (section 4.2).
@@ -60,7 +64,7 @@ use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
 use crate::laplacian_coordinates::RotationInvariantCoordinates;
 use crate::method::{DeformationMethod, IterationObserver, IterationReport, SolveSummary};
-use crate::operators::cotan_laplacian;
+use crate::operators::{laplacian, LaplacianWeights};
 
 /// How the Laplacian coordinates of eq 1 are evaluated in the reduced iteration.
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
@@ -93,6 +97,8 @@ pub struct IsolinesParams {
     pub max_iterations: usize,
     /// Converged when the step falls below `tolerance x bbox diagonal`.
     pub tolerance: f64,
+    /// Weights of `L` (see the module documentation).
+    pub weights: LaplacianWeights,
 }
 
 impl Default for IsolinesParams {
@@ -105,6 +111,7 @@ impl Default for IsolinesParams {
             laplacian_coordinates: LaplacianCoordinates::Isolines,
             max_iterations: 500,
             tolerance: 1e-5,
+            weights: LaplacianWeights::IntrinsicDelaunay,
         }
     }
 }
@@ -182,7 +189,7 @@ impl DeformationMethod for Isolines {
     fn precompute(&mut self, rest: &TriMesh) -> Result<(), MethodError> {
         let start = Instant::now();
         let topology = Topology::new(rest)?;
-        let laplacian = cotan_laplacian(rest.positions(), rest.triangles());
+        let laplacian = laplacian(self.params.weights, rest.positions(), rest.triangles())?;
         self.rest = Some(Rest {
             triangles: rest.triangles().to_vec(),
             topology,

@@ -28,6 +28,10 @@
 //!   count.
 //! - At least three constrained vertices are required (section 4, "at least three"); fewer leave
 //!   the similarity of `G` undetermined.
+//! - Weights (`weights`, default `intrinsic_delaunay`): the only Laplacian of the method is that of
+//!   the section 5.2 initialization (linear Laplacian editing), so the weights enter the initial
+//!   guess only. Algorithm 1 itself has no cotangent Laplacian: step two's `G(Theta, N)` is built
+//!   from corner angles, and step one's normal-pyramid weights are face areas ([`gauss_map`]).
 //! - Every solve starts from the Laplacian initialization of the current shape, so a second edit
 //!   step is handled like the first.
 //! - Acceleration. Algorithm 1 converges linearly and slowly: on the survey cactus the largest step
@@ -71,6 +75,7 @@ use crate::method::{
     finish_iteration, max_displacement, move_to, report_iteration, DeformationMethod, IterationObserver,
     IterationReport, NoObserver, SolveSummary,
 };
+use crate::operators::LaplacianWeights;
 use crate::rotation_fit::Mat3;
 
 /// Parameters of [`ScaleAware`] (configs/methods.toml, sections `[scale_aware]` and
@@ -92,6 +97,8 @@ pub struct ScaleAwareParams {
     pub normal_tolerance: f64,
     /// Soft-constraint weight `omega` of the Laplacian-editing initialization (section 5.2).
     pub initialization_omega: f64,
+    /// Weights of the initialization's Laplacian (see the module documentation).
+    pub weights: LaplacianWeights,
     /// Anderson acceleration depth (0: off).
     pub anderson_depth: usize,
     /// Apply the optimal rigidity approximation (section 5.3) to the converged result.
@@ -107,6 +114,7 @@ impl Default for ScaleAwareParams {
             normal_iterations: 20,
             normal_tolerance: 1e-4,
             initialization_omega: 1000.0,
+            weights: LaplacianWeights::IntrinsicDelaunay,
             optimal_rigidity: false,
             anderson_depth: 5,
         }
@@ -185,6 +193,7 @@ impl ScaleAware {
         }
         let initialization = LaplacianEditing::new(LaplacianParams {
             omega: params.initialization_omega,
+            weights: params.weights,
             max_iterations: 1,
             tolerance: 0.0,
         })?;

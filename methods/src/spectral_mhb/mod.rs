@@ -12,6 +12,12 @@
 //!    transfer (default) or local frames.
 //!
 //! Decisions the paper leaves open (tested in `tests/spectral_mhb.rs`):
+//! - Weights (`weights`, default `intrinsic_delaunay`): `L_s` of the bases (eq 5), of the energy
+//!   (eq 13) and of the deformation-transfer Poisson system, and with it the masses `D` and `M`, which
+//!   for `intrinsic_delaunay` are the intrinsic triangles' ([`crate::operators::lumped_mass_for`]).
+//!   Not the deformation-transfer Poisson system: its right-hand side is built from gradients on
+//!   the mesh's triangles, and `G^T A G` of those is exactly the mesh's cotangent `-L`, which keeps
+//!   the rest shape a fixed point of the detail transfer; it always uses `cotan`.
 //! - Energy form: `S = H^T (M A) H` with `M A = -k_s L_s + k_b L_s M^{-1} L_s`, the Galerkin projection
 //!   of the discrete energy whose Euler–Lagrange equation is eq 13 (symmetric, so the reduced
 //!   problems are symmetric). Under hard constraints eq 14 has the same solution `d` with `A` or
@@ -46,7 +52,7 @@ pub use local_frames::LocalFrameDetails;
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
 use crate::method::{DeformationMethod, IterationObserver, IterationReport, SolveSummary};
-use crate::operators::{cotan_laplacian, lumped_mass, MassKind};
+use crate::operators::{laplacian, lumped_mass_for, LaplacianWeights, MassKind};
 use crate::spectral::{smallest_eigenpairs, EigenOptions};
 
 /// How the handle constraints enter the reduced system.
@@ -87,6 +93,8 @@ pub struct SpectralMhbParams {
     pub eigen_tolerance: f64,
     /// Seed of the eigensolver's start block.
     pub seed: u64,
+    /// Weights of `L_s` and the matching masses (see the module documentation).
+    pub weights: LaplacianWeights,
 }
 
 impl Default for SpectralMhbParams {
@@ -100,6 +108,7 @@ impl Default for SpectralMhbParams {
             details: DetailTransfer::DeformationTransfer,
             eigen_tolerance: 1e-10,
             seed: 0x5eed,
+            weights: LaplacianWeights::IntrinsicDelaunay,
         }
     }
 }
@@ -210,10 +219,10 @@ impl DeformationMethod for SpectralMhb {
 
         // PT1: manifold harmonics bases.
         let start = Instant::now();
-        let laplacian = cotan_laplacian(p, tris);
+        let laplacian = laplacian(self.params.weights, p, tris)?;
         let mut stiffness = laplacian.clone();
         stiffness.val_mut().iter_mut().for_each(|v| *v = -*v);
-        let mhb_mass = lumped_mass(p, tris, MassKind::Barycentric);
+        let mhb_mass = lumped_mass_for(self.params.weights, p, tris, MassKind::Barycentric)?;
         let m = self.params.bases.min(n);
         let mut options = EigenOptions::new(m);
         options.tolerance = self.params.eigen_tolerance;
@@ -230,7 +239,7 @@ impl DeformationMethod for SpectralMhb {
 
         // PT2: S = H^T (-k_s L_s + k_b L_s M^{-1} L_s) H.
         let start = Instant::now();
-        let voronoi = lumped_mass(p, tris, MassKind::Voronoi);
+        let voronoi = lumped_mass_for(self.params.weights, p, tris, MassKind::Voronoi)?;
         let mut ls_h = Mat::<f64>::zeros(n, m);
         sparse_dense_matmul(
             ls_h.as_mut(),
@@ -260,7 +269,10 @@ impl DeformationMethod for SpectralMhb {
         let start = Instant::now();
         self.details = Some(match self.params.details {
             DetailTransfer::DeformationTransfer => {
-                Details::Transfer(DeformationTransfer::new(p, &self.smoothed_rest, tris, &stiffness)?)
+                // The mesh's own -L (see the module documentation): G^T A G of the mesh gradients.
+                let mut poisson = crate::operators::cotan_laplacian(p, tris);
+                poisson.val_mut().iter_mut().for_each(|v| *v = -*v);
+                Details::Transfer(DeformationTransfer::new(p, &self.smoothed_rest, tris, &poisson)?)
             }
             DetailTransfer::LocalFrames => {
                 Details::Frames(LocalFrameDetails::new(p, &self.smoothed_rest, tris))
