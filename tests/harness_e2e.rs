@@ -103,9 +103,20 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
             "cylinder/{method}: e_area {area}, volume {volume}"
         );
     }
-    // HIRM with 10 close handles on the cactus tears and folds: a verdict, not `ok`.
-    let torn = &case("cactus-handles", "hirm")["status"];
-    assert!(torn.starts_with("suspect: ") && torn.contains("folds"), "cactus-handles/hirm: {torn}");
+    // HIRM with 10 close handles on the cactus: with the paper's 6 fields it tore and folded (a
+    // `suspect` verdict, issue 14); with at least 10 fields it bends without folds, within 1.5x of the
+    // isoline model's E_theta (issue 16).
+    let (hirm, isolines) = (case("cactus-handles", "hirm"), case("cactus-handles", "isolines"));
+    assert_eq!(hirm["status"], "ok", "cactus-handles/hirm");
+    assert_eq!(num(hirm, "folds"), 0.0);
+    let ratio = num(hirm, "e_theta_deg") / num(isolines, "e_theta_deg");
+    assert!(ratio <= 1.5, "cactus-handles: hirm E_theta {ratio:.2}x that of isolines");
+    // hirm converges on every survey test (the 200K-vertex sweep bar aside).
+    for scenario in
+        ["bar", "cactus", "cylinder", "plane", "bar-handles", "cactus-handles", "cactus-incremental"]
+    {
+        assert_eq!(case(scenario, "hirm")["converged"], "true", "{scenario}/hirm");
+    }
     // Au et al. 2007, Fig. 9: on the bar twist, fewer isolines show more of the linear effect (kinks
     // between isolines). 20 isolines must bend no worse than 10 (E_phi) and stay no farther from the
     // nonlinear reference (RMS to arap). E_theta is not part of the claim: measured, 20 isolines are

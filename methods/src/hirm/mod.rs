@@ -19,7 +19,11 @@
 //! Decisions the paper leaves open:
 //! - The eigenvectors of the *rest* shape are kept throughout (section 4.5); `W(X)` and the
 //!   Laplacian coordinates `sigma(X) = L X` of the base are rebuilt on the current shape, with `L`
-//!   the rest mesh's cotangent Laplacian.
+//!   the rest mesh's Laplacian.
+//! - `L`'s weights (`weights`, default `intrinsic_delaunay` as for the other methods): the
+//!   propagation fields are the eigenvectors of that `L` with its lumped mass (intrinsic areas), and
+//!   the same `L` gives the Laplacian coordinates. Non-negative weights keep the low eigenvectors
+//!   smooth on meshes with obtuse triangles.
 //! - Soft constraints `omega^2 |Phi W R - H|^2` on every handle vertex, `omega = 1000` as in
 //!   `laplacian` and `isolines` (the paper gives no weight).
 //! - `bind_handles` waits for a background precompute still running; the wait is reported
@@ -63,7 +67,7 @@ use crate::isolines::{
     checked_positions, constraint_rhs, finish_reduced_iteration, ReducedIteration, RotationFit,
 };
 use crate::method::{DeformationMethod, IterationObserver, SolveSummary};
-use crate::operators::cotan_laplacian;
+use crate::operators::{laplacian, lumped_mass_for, LaplacianWeights, MassKind};
 
 /// Parameters of [`Hirm`] (configs/methods.toml, section `[hirm]`).
 #[derive(Clone, Debug, Deserialize)]
@@ -93,6 +97,9 @@ pub struct HirmParams {
     pub tolerance: f64,
     /// Seed of the eigensolver's start vectors.
     pub seed: u64,
+    /// The Laplacian's edge weights (module docs): they enter the propagation fields (the
+    /// eigenvectors of `L` with its mass) and the Laplacian coordinates `sigma = L X`.
+    pub weights: LaplacianWeights,
 }
 
 impl Default for HirmParams {
@@ -109,14 +116,17 @@ impl Default for HirmParams {
             max_iterations: 500,
             tolerance: 1e-5,
             seed: 0x5eed,
+            weights: LaplacianWeights::IntrinsicDelaunay,
         }
     }
 }
 
 /// Rest-mesh data kept for the whole edit session.
 struct Rest {
-    /// `#V x 3` rest positions (the fields are the rest mesh's, also when they grow).
+    /// `#V x 3` rest positions and `#V` lumped mass of `L` (the fields are the rest mesh's, also
+    /// when they grow).
     positions: Vec<[f64; 3]>,
+    mass: Vec<f64>,
     inputs: Arc<SystemInputs>,
     scores: Vec<f64>,
     capped: bool,
@@ -233,7 +243,7 @@ impl Hirm {
         let rest = self.rest.as_mut().expect("precomputed");
         let fields = propagation_fields::propagation_fields_at_least(
             &rest.positions,
-            &rest.inputs.triangles,
+            &rest.mass,
             &rest.inputs.laplacian,
             self.params.threshold,
             count,
@@ -278,10 +288,12 @@ impl DeformationMethod for Hirm {
             worker.finish()?;
         }
         let start = Instant::now();
-        let laplacian = cotan_laplacian(rest.positions(), rest.triangles());
+        let laplacian = laplacian(self.params.weights, rest.positions(), rest.triangles())?;
+        let mass =
+            lumped_mass_for(self.params.weights, rest.positions(), rest.triangles(), MassKind::Barycentric)?;
         let fields = propagation_fields::propagation_fields_at_least(
             rest.positions(),
-            rest.triangles(),
+            &mass,
             &laplacian,
             self.params.threshold,
             self.params.min_fields,
@@ -304,6 +316,7 @@ impl DeformationMethod for Hirm {
         self.precomputed = Some(Precomputed::Ready(Arc::new(model)));
         self.rest = Some(Rest {
             positions: rest.positions().to_vec(),
+            mass,
             inputs,
             scores: fields.scores,
             capped: fields.capped,

@@ -44,9 +44,9 @@ pub fn select_fields(eigenvalues: &[f64], threshold: f64) -> Option<usize> {
 }
 
 /// The propagation fields of the rest mesh (`#V x 3` positions, triangles, and its `#V x #V`
-/// cotangent Laplacian `laplacian`): eigenpairs are computed in growing batches until one scores at
-/// or above `threshold`, or `max_fields` fields are found. `seed` seeds the eigensolver's start
-/// vectors.
+/// cotangent Laplacian `laplacian`, barycentric mass): eigenpairs are computed in growing batches
+/// until one scores at or above `threshold`, or `max_fields` fields are found. `seed` seeds the
+/// eigensolver's start vectors.
 pub fn propagation_fields(
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
@@ -55,15 +55,17 @@ pub fn propagation_fields(
     max_fields: usize,
     seed: u64,
 ) -> Result<PropagationFields, MethodError> {
-    propagation_fields_at_least(positions, triangles, laplacian, threshold, 1, max_fields, seed)
+    let mass = lumped_mass(positions, triangles, MassKind::Barycentric);
+    propagation_fields_at_least(positions, &mass, laplacian, threshold, 1, max_fields, seed)
 }
 
 /// [`propagation_fields`] with at least `min_fields` fields (capped by `max_fields` and the mesh
 /// size), the next eigenvectors in order when fewer score below `threshold`: the remedy of Wu et
 /// al.'s section 5 for handles too close for the selected fields to tell apart.
+/// `mass` is the `#V` lumped mass that goes with `laplacian`.
 pub fn propagation_fields_at_least(
     positions: &[[f64; 3]],
-    triangles: &[[u32; 3]],
+    mass: &[f64],
     laplacian: &SparseColMat<usize, f64>,
     threshold: f64,
     min_fields: usize,
@@ -73,14 +75,13 @@ pub fn propagation_fields_at_least(
     let n = positions.len();
     let mut stiffness = laplacian.clone();
     stiffness.val_mut().iter_mut().for_each(|v| *v = -*v);
-    let mass = lumped_mass(positions, triangles, MassKind::Barycentric);
     let wanted = (max_fields + 1).min(n);
     let floor = (min_fields.min(max_fields) + 1).min(n);
     let mut count = 16.max(floor).min(wanted);
     let pairs = loop {
         let mut options = EigenOptions::new(count);
         options.seed = seed;
-        let pairs = smallest_eigenpairs(stiffness.as_ref(), &mass, &options).map_err(MethodError::Eigen)?;
+        let pairs = smallest_eigenpairs(stiffness.as_ref(), mass, &options).map_err(MethodError::Eigen)?;
         let selected = select_fields(&pairs.values, threshold).ok_or_else(|| {
             MethodError::Mesh(meshes::MeshError::Invalid(format!(
                 "second Laplacian eigenvalue {:e} is not positive: the mesh is not connected",
@@ -107,7 +108,7 @@ pub fn propagation_fields_at_least(
         Mat::from_fn(n, n_field, |k, i| (selected[(k, i)] - ranges[i].0) / (ranges[i].1 - ranges[i].0));
     // Eq 7: omega_i = |(xi_x,i, xi_y,i, xi_z,i)|, normalized to sum 1 (eq 8).
     let x = Mat::from_fn(n, 3, |k, a| positions[k][a]);
-    let xi = transform(selected, &mass, x.as_ref());
+    let xi = transform(selected, mass, x.as_ref());
     let importance: Vec<f64> =
         (0..n_field).map(|i| (0..3).map(|a| xi[(i, a)] * xi[(i, a)]).sum::<f64>().sqrt()).collect();
     let total: f64 = importance.iter().sum();
