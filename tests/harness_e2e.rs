@@ -852,7 +852,7 @@ fn unreferenced_vertices_are_dropped_and_results_keep_the_input_order() {
         format!("name = \"stray\"\nmesh = \"{}\"\nmethods = [\"arap\"]\n{FIXED_AND_HANDLE}", path.display());
     let configs = configs_with(&[("stray.toml".to_string(), text)]);
     let reports = root.path().join("reports");
-    assert_eq!(all_with(configs.path(), reports).unwrap(), std::process::ExitCode::SUCCESS);
+    assert_eq!(all_with(configs.path(), &reports).unwrap(), std::process::ExitCode::SUCCESS);
     let result = meshes::io::read_mesh(reports.join("meshes/stray-arap.off")).unwrap();
     assert_eq!(result.n_vertices(), p.len(), "written in the input's vertex order, the stray included");
     assert_eq!(result.positions()[0], [5.0, 5.0, 5.0], "the stray stays where it was");
