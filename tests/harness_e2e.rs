@@ -50,6 +50,10 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
                 .unwrap_or_else(|| panic!("no row for {scenario} / {method}"));
             assert!(!row["status"].starts_with("failed"), "{scenario}/{method}: {}", row["status"]);
             assert_eq!(row["mesh_source"], "survey");
+            assert_eq!(
+                row["laplacian_weights"], "intrinsic_delaunay",
+                "{scenario}/{method}: the default is reported"
+            );
             let residual = num(row, "handle_residual_over_diag");
             // The bounds for the references; the reduced models only approximate their handles.
             let bound = match method {

@@ -63,6 +63,9 @@ pub struct CaseResult {
     pub mesh_source: String,
     pub vertices: usize,
     pub faces: usize,
+    /// The Laplacian weights the method ran with (`weights` in configs/methods.toml).
+    #[serde(default)]
+    pub laplacian_weights: String,
     #[serde(deserialize_with = "nan_from_null")]
     pub precompute_s: f64,
     #[serde(deserialize_with = "nan_from_null")]
@@ -166,6 +169,7 @@ pub fn run_case(
         scenario.mesh.n_vertices(),
         scenario.mesh.n_faces(),
     );
+    result.laplacian_weights = laplacian_weights(params);
     let mut recorder = Recorder { scenario, rest, trace: Vec::new(), edit_step: 0, quality_s: 0.0 };
     let outcome = (|| -> Result<Vec<String>, methods::MethodError> {
         let mut m = methods::registry::create(method, params)?;
@@ -259,6 +263,14 @@ fn nan_from_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
+/// The `weights` of a method's parameter table, else the shared default (every method's).
+fn laplacian_weights(params: &toml::Table) -> String {
+    match params.get("weights").and_then(|v| v.as_str()) {
+        Some(name) => name.to_string(),
+        None => methods::operators::LaplacianWeights::default().name().to_string(),
+    }
+}
+
 impl CaseResult {
     /// A case that has not run yet: no timings (NaN), no measures, status `ok`, no steps or positions.
     pub fn empty(scenario: &str, method: &str, mesh_source: &str, vertices: usize, faces: usize) -> Self {
@@ -268,6 +280,7 @@ impl CaseResult {
             mesh_source: mesh_source.to_string(),
             vertices,
             faces,
+            laplacian_weights: String::new(),
             precompute_s: f64::NAN,
             bind_s: f64::NAN,
             median_iteration_ms: f64::NAN,

@@ -63,7 +63,7 @@ pub struct ArapParams {
 
 impl Default for ArapParams {
     fn default() -> Self {
-        Self { max_iterations: 1000, tolerance: 1e-5, weights: LaplacianWeights::IntrinsicDelaunay }
+        Self { max_iterations: 1000, tolerance: 1e-5, weights: LaplacianWeights::default() }
     }
 }
 

@@ -54,12 +54,7 @@ pub struct LaplacianParams {
 
 impl Default for LaplacianParams {
     fn default() -> Self {
-        Self {
-            omega: 1000.0,
-            max_iterations: 2000,
-            tolerance: 1e-5,
-            weights: LaplacianWeights::IntrinsicDelaunay,
-        }
+        Self { omega: 1000.0, max_iterations: 2000, tolerance: 1e-5, weights: LaplacianWeights::default() }
     }
 }
 

@@ -116,7 +116,7 @@ impl Default for HirmParams {
             max_iterations: 500,
             tolerance: 1e-5,
             seed: 0x5eed,
-            weights: LaplacianWeights::IntrinsicDelaunay,
+            weights: LaplacianWeights::default(),
         }
     }
 }

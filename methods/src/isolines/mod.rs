@@ -111,7 +111,7 @@ impl Default for IsolinesParams {
             laplacian_coordinates: LaplacianCoordinates::Isolines,
             max_iterations: 500,
             tolerance: 1e-5,
-            weights: LaplacianWeights::IntrinsicDelaunay,
+            weights: LaplacianWeights::default(),
         }
     }
 }

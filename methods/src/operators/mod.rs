@@ -46,6 +46,24 @@ pub enum LaplacianWeights {
     IntrinsicDelaunay,
 }
 
+impl Default for LaplacianWeights {
+    /// `IntrinsicDelaunay`, every method's default (configs/methods.toml says why).
+    fn default() -> Self {
+        LaplacianWeights::IntrinsicDelaunay
+    }
+}
+
+impl LaplacianWeights {
+    /// The name in configs and reports: `cotan`, `clamped`, `intrinsic_delaunay`.
+    pub fn name(self) -> &'static str {
+        match self {
+            LaplacianWeights::Cotan => "cotan",
+            LaplacianWeights::Clamped => "clamped",
+            LaplacianWeights::IntrinsicDelaunay => "intrinsic_delaunay",
+        }
+    }
+}
+
 /// `#V x #V` Laplacian of `positions` (`#V x 3`) / `triangles` (`#F x 3`) with the given weights,
 /// all with [`cotan_laplacian`]'s sign (`L_ij >= 0` off the diagonal for non-negative weights,
 /// `L 1 = 0`) and CSC layout with sorted rows. Fails only for `IntrinsicDelaunay` on a degenerate or

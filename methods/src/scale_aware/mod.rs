@@ -114,7 +114,7 @@ impl Default for ScaleAwareParams {
             normal_iterations: 20,
             normal_tolerance: 1e-4,
             initialization_omega: 1000.0,
-            weights: LaplacianWeights::IntrinsicDelaunay,
+            weights: LaplacianWeights::default(),
             optimal_rigidity: false,
             anderson_depth: 5,
         }

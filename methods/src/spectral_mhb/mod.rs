@@ -108,7 +108,7 @@ impl Default for SpectralMhbParams {
             details: DetailTransfer::DeformationTransfer,
             eigen_tolerance: 1e-10,
             seed: 0x5eed,
-            weights: LaplacianWeights::IntrinsicDelaunay,
+            weights: LaplacianWeights::default(),
         }
     }
 }
