@@ -267,3 +267,42 @@ fn fields_grow_to_the_handle_count_and_at_least_min_fields_are_kept() {
     hirm.bind_handles(&HandleSet::new(regions, mesh.n_vertices()).unwrap()).unwrap();
     assert_eq!(n_field(&hirm), 8.0);
 }
+
+/// Incremental editing keeps the regions of the step before: the background worker adds their
+/// constraint term, and the next bind adds only the new region's rows. The factor equals that of the
+/// bind that builds the whole term (the same regions in another order take that path).
+#[test]
+fn a_bind_that_keeps_the_previous_regions_gives_the_whole_system() {
+    let (mesh, handles) = bar();
+    let n = mesh.n_vertices() as u32;
+    let factor_of_second_bind = |reorder: bool| -> faer::Mat<f64> {
+        let mut hirm = Hirm::new(HirmParams::default()).unwrap();
+        hirm.precompute(&mesh).unwrap();
+        hirm.bind_handles(&handles).unwrap();
+        let t = targets(&handles, &hirm.positions(), [0.0, 0.0, 0.1]);
+        hirm.solve(&t, &mut NoObserver).unwrap();
+        let patch = HandleRegion { name: "patch".into(), vertices: vec![n / 2, n / 2 + 1] };
+        let mut regions = handles.regions().to_vec();
+        if reorder {
+            regions.insert(0, patch);
+        } else {
+            regions.push(patch);
+        }
+        hirm.bind_handles(&HandleSet::new(regions, mesh.n_vertices()).unwrap()).unwrap();
+        hirm.handle_update_factor().to_owned()
+    };
+    let (kept, whole) = (factor_of_second_bind(false), factor_of_second_bind(true));
+    let size = kept.nrows();
+    let mut largest = 0.0f64;
+    let mut scale = 0.0f64;
+    for j in 0..size {
+        for i in j..size {
+            largest = largest.max((kept[(i, j)] - whole[(i, j)]).abs());
+            scale = scale.max(whole[(i, j)].abs());
+        }
+    }
+    assert!(
+        largest <= 1e-10 * scale,
+        "kept-term factor differs from the whole build by {largest:e} (of {scale:e})"
+    );
+}

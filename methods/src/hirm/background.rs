@@ -5,6 +5,10 @@
 //! `W = W(X)` (eq 22), `T_1 = U^^T U^` with `U^ = [L W; mu M]` (eq 23–24), and `W^T L^T W_sigma`,
 //! which gives `T_2 = W^T L^T W_sigma R_sigma(X)` (eq 25) for any isoline rotations `R_sigma`.
 //! Binding a handle set then only adds `(Phi W)^T (Phi W)` (eq 26).
+//!
+//! Incremental editing keeps the regions of the step before (they are held where they are), so the
+//! worker also adds their constraint term to `T_1` ([`KeptConstraints`]): a bind that keeps them adds
+//! only the rows of its new regions (the same sum, in the same order, as the whole term).
 
 use std::sync::Arc;
 use std::thread::JoinHandle;
@@ -14,7 +18,8 @@ use faer::sparse::SparseColMat;
 use faer::Mat;
 
 use crate::error::MethodError;
-use crate::isolines::{HandleIndependentSystem, IsolineModel, SetBlend};
+use crate::handles::{HandleRegion, HandleSet};
+use crate::isolines::{add_constraint_rows_lower, HandleIndependentSystem, IsolineModel, SetBlend};
 
 /// What the handle-independent system is built from besides the base shape: fixed for a rest mesh.
 pub struct SystemInputs {
@@ -37,8 +42,29 @@ pub struct SystemInputs {
 pub struct HandleIndependentModel {
     pub model: IsolineModel,
     pub system: HandleIndependentSystem,
-    /// Wall time of [`handle_independent_model`] (HIRM's `t_b`).
+    /// `T_1` plus the constraint term of the previous handle set's regions, when the worker was told
+    /// them.
+    pub kept: Option<KeptConstraints>,
+    /// Wall time of [`handle_independent_model`] (HIRM's `t_b`), the kept term included.
     pub seconds: f64,
+}
+
+/// `T_1 + omega^2 (Phi W)^T (Phi W)` over the constrained vertices of `regions` (lower triangle,
+/// `4N x 4N`): the start of every later handle set that keeps those regions.
+pub struct KeptConstraints {
+    pub regions: Vec<HandleRegion>,
+    pub omega: f64,
+    pub lower: Mat<f64>,
+}
+
+impl KeptConstraints {
+    /// Whether `handles` starts with exactly these regions (same names and vertices, in order) with
+    /// the same `omega`: then its constraint term is this one plus the rows of its other regions.
+    pub fn is_prefix_of(&self, handles: &HandleSet, omega: f64) -> bool {
+        self.omega == omega
+            && handles.regions().len() >= self.regions.len()
+            && handles.regions()[..self.regions.len()] == self.regions[..]
+    }
 }
 
 /// Eq 22–25 on the `#V x 3` base shape `base`, synchronously.
@@ -54,7 +80,28 @@ pub fn handle_independent_model(base: &[[f64; 3]], inputs: &SystemInputs) -> Han
     );
     let mut system = HandleIndependentSystem::new(&mut model, inputs.laplacian.as_ref(), inputs.mu, true);
     fix_field_gauge(&mut system.smoothness_normal_matrix, inputs.fields.ncols(), inputs.isolines);
-    HandleIndependentModel { model, system, seconds: start.elapsed().as_secs_f64() }
+    HandleIndependentModel { model, system, kept: None, seconds: start.elapsed().as_secs_f64() }
+}
+
+/// [`handle_independent_model`] and, for `kept` (the regions of the handle set before, and `omega`),
+/// their constraint term on `T_1`.
+pub fn handle_independent_model_keeping(
+    base: &[[f64; 3]],
+    inputs: &SystemInputs,
+    kept: Option<(Vec<HandleRegion>, f64)>,
+) -> HandleIndependentModel {
+    let start = Instant::now();
+    let mut out = handle_independent_model(base, inputs);
+    if let Some((regions, omega)) = kept {
+        let size = out.system.smoothness_normal_matrix.nrows();
+        let mut lower = Mat::<f64>::zeros(size, size);
+        lower.copy_from_triangular_lower(out.system.smoothness_normal_matrix.as_ref());
+        let vertices = regions.iter().flat_map(|r| r.vertices.iter().copied());
+        add_constraint_rows_lower(&out.model, vertices, omega, lower.as_mut());
+        out.kept = Some(KeptConstraints { regions, omega, lower });
+    }
+    out.seconds = start.elapsed().as_secs_f64();
+    out
 }
 
 /// Make `T_1` definite up to a common translation by fixing the gauge of the per-field blend.
@@ -90,9 +137,14 @@ pub struct BackgroundPrecompute {
 }
 
 impl BackgroundPrecompute {
-    /// Start computing the system of `base` (`#V x 3`, moved to the worker).
-    pub fn start(base: Vec<[f64; 3]>, inputs: Arc<SystemInputs>) -> Self {
-        let worker = std::thread::spawn(move || handle_independent_model(&base, &inputs));
+    /// Start computing the system of `base` (`#V x 3`, moved to the worker), with the constraint
+    /// term of the `kept` regions (see [`handle_independent_model_keeping`]).
+    pub fn start(
+        base: Vec<[f64; 3]>,
+        inputs: Arc<SystemInputs>,
+        kept: Option<(Vec<HandleRegion>, f64)>,
+    ) -> Self {
+        let worker = std::thread::spawn(move || handle_independent_model_keeping(&base, &inputs, kept));
         Self { worker }
     }
 

@@ -9,8 +9,10 @@
 //! `R = (U^T U)^{-1} [W^T L^T W_sigma R_sigma(X) + omega^2 W^T Phi^T H]` (eq 20), with `R_sigma` the
 //! isoline rotations of eq 17–19 fitted to the sampled crossed triangles only, so per-iteration work
 //! does not depend on `#V`. Section 4.5: after each solve a worker thread recomputes the
-//! handle-independent `T_1`, `T_2` (eq 22–25) on the current shape ([`background`]); binding a new
-//! handle set only adds `(Phi W)^T (Phi W)` and factors the `4N x 4N` matrix (eq 26–28).
+//! handle-independent `T_1`, `T_2` (eq 22–25) on the current shape ([`background`]), with the
+//! constraint term of the handle set just solved for; binding a new handle set that keeps those
+//! regions (incremental editing) only adds the rows of its new regions and factors the `4N x 4N`
+//! matrix (eq 26–28).
 //!
 //! The isoline machinery (tracing, two-level interpolation, the reduced matrices) is shared with
 //! [`crate::isolines`]; what differs is where the fields come from, how they are blended
@@ -64,7 +66,8 @@ pub use propagation_fields::{propagation_fields, select_fields, PropagationField
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
 use crate::isolines::{
-    checked_positions, constraint_rhs, finish_reduced_iteration, ReducedIteration, RotationFit,
+    add_constraint_rows_lower, checked_positions, constraint_rhs, finish_reduced_iteration, ReducedIteration,
+    RotationFit,
 };
 use crate::method::{DeformationMethod, IterationObserver, SolveSummary};
 use crate::operators::{laplacian, lumped_mass_for, LaplacianWeights, MassKind};
@@ -212,6 +215,11 @@ impl Hirm {
         self.bound.as_ref().map(|b| b.independent.as_ref())
     }
 
+    /// `L` of `U^T U = L L^T` (eq 26) of the bound handle set, `4N x 4N` lower triangle (for tests).
+    pub fn handle_update_factor(&self) -> faer::MatRef<'_, f64> {
+        self.normal_factor.as_ref()
+    }
+
     /// Wait for a background precompute still running and return the current handle-independent
     /// model (for tests: compare with [`handle_independent_model`] on [`Self::positions`]).
     pub fn handle_independent(&mut self) -> Result<Option<Arc<HandleIndependentModel>>, MethodError> {
@@ -348,12 +356,26 @@ impl DeformationMethod for Hirm {
             self.factor_workspace =
                 MemBuffer::new(cholesky_in_place_scratch::<f64>(size, Par::Seq, Default::default()));
         }
-        independent.system.constrained_normal_matrix_lower_into(
-            &independent.model,
-            handles,
-            self.params.omega,
-            self.normal_factor.as_mut(),
-        );
+        match independent.kept.as_ref().filter(|k| k.is_prefix_of(handles, self.params.omega)) {
+            // The regions of the step before are kept: their term was added in the background.
+            Some(kept) => {
+                self.normal_factor.copy_from_triangular_lower(kept.lower.as_ref());
+                let new =
+                    handles.regions()[kept.regions.len()..].iter().flat_map(|r| r.vertices.iter().copied());
+                add_constraint_rows_lower(
+                    &independent.model,
+                    new,
+                    self.params.omega,
+                    self.normal_factor.as_mut(),
+                );
+            }
+            None => independent.system.constrained_normal_matrix_lower_into(
+                &independent.model,
+                handles,
+                self.params.omega,
+                self.normal_factor.as_mut(),
+            ),
+        }
         cholesky_in_place(
             self.normal_factor.as_mut(),
             Default::default(),
@@ -414,7 +436,8 @@ impl DeformationMethod for Hirm {
         let current = checked_positions("hirm", model, self.reduced.as_ref(), summary.iterations)?;
         let positions_seconds = t1.elapsed().as_secs_f64();
         // Section 4.5: the next handle set's T_1, T_2 are computed on this shape in the background.
-        let worker = BackgroundPrecompute::start(current.clone(), rest.inputs.clone());
+        let kept = Some((bound.handles.regions().to_vec(), self.params.omega));
+        let worker = BackgroundPrecompute::start(current.clone(), rest.inputs.clone(), kept);
         self.current = current;
         self.precomputed = Some(Precomputed::Running(worker));
         self.set_timing("solve_constraint_rhs", setup);

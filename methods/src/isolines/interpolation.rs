@@ -511,7 +511,7 @@ impl HandleIndependentSystem {
         omega: f64,
     ) -> Mat<f64> {
         let mut normal_matrix = self.smoothness_normal_matrix.clone();
-        add_constraint_term_lower(model, handles, omega, normal_matrix.as_mut());
+        add_constraint_term_lower(model, handles.constrained(), omega, normal_matrix.as_mut());
         let n = normal_matrix.nrows();
         for j in 0..n {
             for i in 0..j {
@@ -532,8 +532,20 @@ impl HandleIndependentSystem {
         mut out: MatMut<'_, f64>,
     ) {
         out.copy_from_triangular_lower(self.smoothness_normal_matrix.as_ref());
-        add_constraint_term_lower(model, handles, omega, out);
+        add_constraint_term_lower(model, handles.constrained(), omega, out);
     }
+}
+
+/// `out += omega^2 (Phi W_x)^T (Phi W_x)` over the rows of `vertices` only, on the lower triangle of
+/// the `4N x 4N` `out`: the constraint term of eq 26 added vertex by vertex, in the given order (so a
+/// matrix that already holds the term of some regions grows to the same bits as one built whole).
+pub fn add_constraint_rows_lower(
+    model: &IsolineModel,
+    vertices: impl Iterator<Item = u32>,
+    omega: f64,
+    out: MatMut<'_, f64>,
+) {
+    add_constraint_term_lower(model, vertices, omega, out);
 }
 
 /// `out += omega^2 (Phi W_x)^T (Phi W_x)` on the lower triangle of the `4N x 4N` `out` (the
@@ -543,12 +555,12 @@ impl HandleIndependentSystem {
 /// columns. Only the blocks of isoline pairs `(p, q)` with `p >= q` are accumulated, 4 wide.
 fn add_constraint_term_lower(
     model: &IsolineModel,
-    handles: &HandleSet,
+    vertices: impl Iterator<Item = u32>,
     omega: f64,
     mut out: MatMut<'_, f64>,
 ) {
     let w2 = omega * omega;
-    for v in handles.constrained() {
+    for v in vertices {
         let x = model.base[v as usize];
         let h = [x[0], x[1], x[2], 1.0];
         let local = model.vertex_weights(v as usize);

@@ -57,7 +57,8 @@ use serde::Deserialize;
 
 pub use harmonic_fields::harmonic_fields;
 pub use interpolation::{
-    constraint_rhs, HandleIndependentSystem, IsolineModel, ReducedSystem, RotationFit, SetBlend,
+    add_constraint_rows_lower, constraint_rhs, HandleIndependentSystem, IsolineModel, ReducedSystem,
+    RotationFit, SetBlend,
 };
 
 use crate::error::MethodError;
