@@ -899,3 +899,39 @@ fn the_real_mesh_suite_runs_from_toml_alone() {
     let result = meshes::io::read_mesh(reports.path().join("meshes/max-isolines.off")).unwrap();
     assert_eq!(result.n_vertices(), 5272, "written in the OBJ's vertex order");
 }
+
+/// A collection: one scenario `<name>-<stem>` per file the glob matches (sorted), the same shape
+/// rule on each, and the `{stem}` of a region file naming each mesh's own.
+#[test]
+fn a_collection_runs_one_scenario_per_matching_mesh() {
+    let root = tempfile::tempdir().unwrap();
+    for (stem, n) in [("b-large", 900), ("a-small", 500)] {
+        let shape = generate(ShapeKind::Bar, n).unwrap();
+        meshes::io::write_off(root.path().join(format!("{stem}.off")), &shape.mesh).unwrap();
+        meshes::io::write_selection(root.path().join(format!("{stem}.sel")), &shape.selection).unwrap();
+    }
+    std::fs::write(root.path().join("notes.txt"), "not a mesh").unwrap();
+    let text = format!(
+        "name = \"bars\"\nmeshes = \"{}/*.off\"\nmethods = [\"arap\"]\n\
+         [[regions]]\nname = \"base\"\nrole = \"fixed\"\nselect = {{ sel = {{ file = \"{}/{{stem}}.sel\", status = 0 }} }}\n\
+         [[regions]]\nname = \"top\"\nrole = \"handle\"\nselect = {{ slab = {{ axis = \"z\", from = 0.95, to = 1.0 }} }}\n\
+         translate = [0.1, 0.0, 0.0]\n",
+        root.path().display(),
+        root.path().display()
+    );
+    let configs = configs_with(&[("bars.toml".to_string(), text)]);
+    let reports = root.path().join("reports");
+    assert_eq!(all_with(configs.path(), &reports).unwrap(), std::process::ExitCode::SUCCESS);
+    let rows = csv_rows(&reports.join("results.csv"));
+    let names: Vec<(&str, &str)> =
+        rows.iter().map(|r| (r["scenario"].as_str(), r["vertices"].as_str())).collect();
+    let sizes: Vec<usize> = ["a-small", "b-large"]
+        .iter()
+        .map(|s| meshes::io::read_mesh(root.path().join(format!("{s}.off"))).unwrap().n_vertices())
+        .collect();
+    assert_eq!(
+        names,
+        [("bars-a-small", sizes[0].to_string().as_str()), ("bars-b-large", sizes[1].to_string().as_str())]
+    );
+    assert!(rows.iter().all(|r| r["status"] == "ok"), "{rows:?}");
+}
