@@ -229,15 +229,14 @@ pub fn run_case(
             Reference::Of(r) => Some(r),
             Reference::Missing => None,
         };
-        result.quality = Quality::evaluate(&Evaluation {
+        result.quality = Quality::evaluate(&Evaluation::new(
             rest,
-            mesh: &scenario.mesh,
-            topology: &scenario.topology,
-            result: &positions,
-            handles: &step.handles,
-            targets: &targets,
+            &scenario.mesh,
+            &scenario.topology,
+            &positions,
+            (&step.handles, &targets),
             reference,
-        });
+        ));
         result.largest_move_over_diag =
             largest_displacement(scenario.mesh.positions(), &positions) / rest.diagonal;
         result.largest_handle_move_over_diag = largest_handle_move / rest.diagonal;

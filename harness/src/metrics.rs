@@ -2,7 +2,7 @@
 //! the CSV/JSON writers, the printed table, `index.html`, the plots and the regression gate all read.
 //! A new measure is one [`Metric`] variant, one [`MetricSpec`] row and its function.
 //!
-//! The angle errors are the scale-aware paper's (Liu et al. 2011, sec. 5.1); they are blind to
+//! The angle errors are the scale-aware paper's (Liu et al. 2010, sec. 5.1); they are blind to
 //! uniform scaling and to folds, which the area, length, volume and fold measures see.
 
 use std::fmt;
@@ -88,6 +88,59 @@ pub struct Evaluation<'a> {
     pub targets: &'a HandleTargets,
     /// `#V x 3` result of the reference method (`arap`) on the same scenario, if it has one.
     pub reference: Option<&'a [[f64; 3]]>,
+    /// The result's corner and dihedral angles, computed once for every measure that needs them.
+    pub angles: ResultAngles,
+}
+
+impl<'a> Evaluation<'a> {
+    /// The evaluation of the `#V x 3` `result` on `mesh` (with `rest` its rest geometry), whose last
+    /// step held `handles` at `targets`, against the `reference` result if there is one.
+    pub fn new(
+        rest: &'a RestGeometry,
+        mesh: &'a TriMesh,
+        topology: &'a Topology,
+        result: &'a [[f64; 3]],
+        (handles, targets): (&'a HandleSet, &'a HandleTargets),
+        reference: Option<&'a [[f64; 3]]>,
+    ) -> Self {
+        let angles = ResultAngles::new(mesh, topology, result);
+        Self { rest, mesh, topology, result, handles, targets, reference, angles }
+    }
+}
+
+/// `#F x 3` corner angles and the dihedral angles of the interior edges of a result (radians).
+pub struct ResultAngles {
+    corners: Vec<[f64; 3]>,
+    dihedrals: Vec<f64>,
+}
+
+impl ResultAngles {
+    /// The angles of the `#V x 3` `result` on the connectivity of `mesh`.
+    pub fn new(mesh: &TriMesh, topology: &Topology, result: &[[f64; 3]]) -> Self {
+        Self {
+            corners: corner_angles(result, mesh.triangles()),
+            dihedrals: dihedral_angles(result, mesh.triangles(), topology),
+        }
+    }
+
+    /// `(E_theta, E_phi)` in degrees against `rest` (see [`angle_errors`]).
+    fn errors(&self, rest: &RestGeometry) -> (f64, f64) {
+        let e_theta =
+            rms(rest.corners.iter().flatten().zip(self.corners.iter().flatten()).map(|(a, b)| a - b));
+        let e_phi = rms(rest.dihedrals.iter().zip(&self.dihedrals).map(|(a, b)| a - b));
+        (e_theta.to_degrees(), e_phi.to_degrees())
+    }
+
+    /// The fraction of interior edges folded against `rest` (see [`folds`]).
+    fn folded_fraction(&self, rest: &RestGeometry) -> f64 {
+        let folded =
+            rest.dihedrals.iter().zip(&self.dihedrals).filter(|(a, b)| (*a - *b).abs() > FOLD_ANGLE).count();
+        if self.dihedrals.is_empty() {
+            0.0
+        } else {
+            folded as f64 / self.dihedrals.len() as f64
+        }
+    }
 }
 
 /// One row of the metric table.
@@ -124,7 +177,7 @@ pub const METRICS: [MetricSpec; 9] = [
         gate: Some(Tolerance { relative: 0.02, absolute: 0.01 }),
         plotted: true,
         format: Format::Fixed(3),
-        compute: |e| Some(angle_errors(e.rest, e.mesh, e.topology, e.result).0),
+        compute: |e| Some(e.angles.errors(e.rest).0),
     },
     MetricSpec {
         metric: Metric::EPhi,
@@ -136,7 +189,7 @@ pub const METRICS: [MetricSpec; 9] = [
         gate: Some(Tolerance { relative: 0.02, absolute: 0.01 }),
         plotted: true,
         format: Format::Fixed(3),
-        compute: |e| Some(angle_errors(e.rest, e.mesh, e.topology, e.result).1),
+        compute: |e| Some(e.angles.errors(e.rest).1),
     },
     MetricSpec {
         metric: Metric::EArea,
@@ -186,7 +239,7 @@ pub const METRICS: [MetricSpec; 9] = [
         gate: Some(Tolerance { relative: 0.02, absolute: 1e-5 }),
         plotted: false,
         format: Format::Percent(3),
-        compute: |e| Some(folds(e.rest, e.mesh, e.topology, e.result)),
+        compute: |e| Some(e.angles.folded_fraction(e.rest)),
     },
     MetricSpec {
         metric: Metric::HandleResidual,
@@ -385,11 +438,7 @@ pub fn angle_errors(
     topology: &Topology,
     result: &[[f64; 3]],
 ) -> (f64, f64) {
-    let corners = corner_angles(result, mesh.triangles());
-    let e_theta = rms(rest.corners.iter().flatten().zip(corners.iter().flatten()).map(|(a, b)| a - b));
-    let dihedrals = dihedral_angles(result, mesh.triangles(), topology);
-    let e_phi = rms(rest.dihedrals.iter().zip(&dihedrals).map(|(a, b)| a - b));
-    (e_theta.to_degrees(), e_phi.to_degrees())
+    ResultAngles::new(mesh, topology, result).errors(rest)
 }
 
 /// `e_area = sqrt(mean_f ln(A_f / A_f⁰)²)` over the faces of positive rest area (a rest face of zero
@@ -424,13 +473,7 @@ pub const FOLD_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
 /// Fraction of interior edges whose dihedral angle changed by more than [`FOLD_ANGLE`] (0 for a mesh
 /// without interior edges).
 pub fn folds(rest: &RestGeometry, mesh: &TriMesh, topology: &Topology, result: &[[f64; 3]]) -> f64 {
-    let dihedrals = dihedral_angles(result, mesh.triangles(), topology);
-    let folded = rest.dihedrals.iter().zip(&dihedrals).filter(|(a, b)| (*a - *b).abs() > FOLD_ANGLE).count();
-    if dihedrals.is_empty() {
-        0.0
-    } else {
-        folded as f64 / dihedrals.len() as f64
-    }
+    ResultAngles::new(mesh, topology, result).folded_fraction(rest)
 }
 
 /// Largest distance of a constrained vertex from its target, divided by `diagonal`.
@@ -504,15 +547,14 @@ mod tests {
         )
         .unwrap();
         let targets = HandleTargets::new(&handles, vec![moved[0]]).unwrap();
-        Quality::evaluate(&Evaluation {
-            rest: &rest,
-            mesh: &mesh,
-            topology: &topology,
-            result: &moved,
-            handles: &handles,
-            targets: &targets,
-            reference: Some(&moved),
-        })
+        Quality::evaluate(&Evaluation::new(
+            &rest,
+            &mesh,
+            &topology,
+            &moved,
+            (&handles, &targets),
+            Some(&moved),
+        ))
     }
 
     #[test]

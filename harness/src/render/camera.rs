@@ -86,8 +86,7 @@ impl Camera {
     /// union of the bounding boxes of the `#V x 3` position arrays in `shapes` (the rest shape and
     /// every result; non-finite coordinates are ignored), for an image of `aspect` = width / height.
     pub fn for_shapes<'a>(shapes: impl IntoIterator<Item = &'a [[f64; 3]]>, aspect: f64) -> Camera {
-        let (lo, hi) = union_bbox(shapes).unwrap_or(([0.0; 3], [1.0; 3]));
-        Camera::framing(VIEW_FROM, VIEW_UP, lo, hi, aspect)
+        Camera::for_shapes_up(shapes, aspect, 2)
     }
 
     /// [`Camera::for_shapes`] for a scene standing on `up` (0: x, 1: y, 2: z) instead of `z`: the same

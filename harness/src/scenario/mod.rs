@@ -92,7 +92,7 @@ pub struct ScenarioSpec {
     /// Methods to run (default: all registered).
     #[serde(default)]
     pub methods: Option<Vec<String>>,
-    /// Edit steps (default: the survey edit alone).
+    /// Edit steps (default: the first edit alone, the survey's or the `[[regions]]`).
     #[serde(default)]
     pub steps: Vec<StepSpec>,
     /// The file it was read from.
@@ -100,7 +100,9 @@ pub struct ScenarioSpec {
     pub path: PathBuf,
 }
 
-/// A region as written: its vertices and, for a handle, its transform (see [`motion`]).
+/// A region as written: its vertices and, for a handle, its transform (see [`motion`]). The
+/// transform fields repeat [`TransformSpec`]'s because serde cannot flatten it and still reject
+/// unknown keys.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RegionSpec {

@@ -160,23 +160,32 @@ impl Selection {
         Ok(kept)
     }
 
-    /// Shapes: mesh vertex ids; files and lists: input vertex ids.
+    /// Shapes: mesh vertex ids (of the `#V x 3` mesh `positions`); files and lists: input vertex ids.
     fn pick(
         &self,
-        input_positions: &[[f64; 3]],
+        positions: &[[f64; 3]],
         input: &InputIndex,
         paths: &PathContext,
         files: &dyn SelectionFiles,
     ) -> Result<Vec<u32>, String> {
         let n_input = input.n_input();
-        let n = input_positions.len();
-        let (lo, hi) = meshes::geometry::bbox(input_positions);
+        let (lo, hi) = meshes::geometry::bbox(positions);
         let diagonal = norm(sub(hi, lo));
         let to_box = |p: [f64; 3]| -> [f64; 3] {
             std::array::from_fn(|k| if hi[k] > lo[k] { (p[k] - lo[k]) / (hi[k] - lo[k]) } else { 0.5 })
         };
         let from_box = |c: [f64; 3]| -> [f64; 3] { std::array::from_fn(|k| lo[k] + c[k] * (hi[k] - lo[k])) };
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        // The mesh vertices at which `inside` holds, or the error `empty` says.
+        let within = |inside: &dyn Fn([f64; 3]) -> bool, empty: &dyn Fn() -> String| {
+            let picked: Vec<u32> =
+                (0..positions.len() as u32).filter(|&v| inside(positions[v as usize])).collect();
+            if picked.is_empty() {
+                Err(empty())
+            } else {
+                Ok(picked)
+            }
+        };
         let picked: Vec<u32> = match self {
             Selection::Sel { file, status } => {
                 let path = paths.resolve(file)?;
@@ -212,51 +221,26 @@ impl Selection {
                 if !(finite(min) && finite(max)) || (0..3).any(|k| min[k] > max[k]) {
                     return Err(format!("box: min {min:?} must be finite and <= max {max:?}"));
                 }
-                let picked = (0..n as u32)
-                    .filter(|&v| {
-                        let c = to_box(input_positions[v as usize]);
-                        (0..3).all(|k| c[k] >= min[k] && c[k] <= max[k])
-                    })
-                    .collect::<Vec<_>>();
-                if picked.is_empty() {
-                    return Err(format!(
-                        "box {min:?}..{max:?} (bbox coordinates, [0, 1] spans the mesh) holds no vertex"
-                    ));
-                }
-                picked
+                within(&|p| (0..3).all(|k| (min[k]..=max[k]).contains(&to_box(p)[k])), &|| {
+                    format!("box {min:?}..{max:?} (bbox coordinates, [0, 1] spans the mesh) holds no vertex")
+                })?
             }
             Selection::Sphere { center, radius } => {
                 if !(finite(center) && radius.is_finite() && *radius > 0.0) {
                     return Err(format!("sphere: center {center:?} finite and radius {radius} > 0 needed"));
                 }
                 let c = from_box(*center);
-                let picked = (0..n as u32)
-                    .filter(|&v| norm(sub(input_positions[v as usize], c)) <= radius * diagonal)
-                    .collect::<Vec<_>>();
-                if picked.is_empty() {
-                    return Err(format!(
-                        "sphere at {center:?} (bbox coordinates) with radius {radius} x diagonal holds no vertex"
-                    ));
-                }
-                picked
+                within(&|p| norm(sub(p, c)) <= radius * diagonal, &|| {
+                    format!("sphere at {center:?} (bbox coordinates) with radius {radius} x diagonal holds no vertex")
+                })?
             }
             Selection::Slab { axis, from, to } => {
                 if !(from.is_finite() && to.is_finite() && from <= to) {
                     return Err(format!("slab: from {from} must be finite and <= to {to}"));
                 }
-                let k = axis.index();
-                let picked = (0..n as u32)
-                    .filter(|&v| {
-                        let c = to_box(input_positions[v as usize])[k];
-                        c >= *from && c <= *to
-                    })
-                    .collect::<Vec<_>>();
-                if picked.is_empty() {
-                    return Err(format!(
-                        "slab {axis:?} {from}..{to} (bbox coordinates, [0, 1] spans the mesh) holds no vertex"
-                    ));
-                }
-                picked
+                within(&|p| (*from..=*to).contains(&to_box(p)[axis.index()]), &|| {
+                    format!("slab {axis:?} {from}..{to} (bbox coordinates, [0, 1] spans the mesh) holds no vertex")
+                })?
             }
         };
         Ok(picked)

@@ -28,7 +28,7 @@ pub struct SystemInputs {
     pub fields: Mat<f64>,
     /// `omega_bar_i`, one per field.
     pub weights: Vec<f64>,
-    /// `#V x #V` cotangent Laplacian of the rest mesh.
+    /// `#V x #V` Laplacian of the rest mesh (with the method's `weights`).
     pub laplacian: SparseColMat<usize, f64>,
     /// `n_iso`, isolines per field.
     pub isolines: usize,

@@ -1,6 +1,6 @@
 //! Propagation fields (Wu et al. 2015, section 4.1) and their blending weights (section 4.3).
 //!
-//! The fields are the first non-constant eigenvectors of the cotangent Laplacian of the rest mesh,
+//! The fields are the first non-constant eigenvectors of the Laplacian of the rest mesh,
 //! `Q e = lambda D e` with `Q = -L` and the barycentric lumped mass `D` (the manifold harmonics of
 //! [`crate::spectral`]), selected by the score `S_i = sqrt(lambda_i / lambda_2) < phi` (eq 1–2).
 //!

@@ -511,7 +511,7 @@ impl HandleIndependentSystem {
         omega: f64,
     ) -> Mat<f64> {
         let mut normal_matrix = self.smoothness_normal_matrix.clone();
-        add_constraint_term_lower(model, handles.constrained(), omega, normal_matrix.as_mut());
+        add_constraint_rows_lower(model, handles.constrained(), omega, normal_matrix.as_mut());
         let n = normal_matrix.nrows();
         for j in 0..n {
             for i in 0..j {
@@ -532,28 +532,18 @@ impl HandleIndependentSystem {
         mut out: MatMut<'_, f64>,
     ) {
         out.copy_from_triangular_lower(self.smoothness_normal_matrix.as_ref());
-        add_constraint_term_lower(model, handles.constrained(), omega, out);
+        add_constraint_rows_lower(model, handles.constrained(), omega, out);
     }
 }
 
-/// `out += omega^2 (Phi W_x)^T (Phi W_x)` over the rows of `vertices` only, on the lower triangle of
-/// the `4N x 4N` `out`: the constraint term of eq 26 added vertex by vertex, in the given order (so a
-/// matrix that already holds the term of some regions grows to the same bits as one built whole).
-pub fn add_constraint_rows_lower(
-    model: &IsolineModel,
-    vertices: impl Iterator<Item = u32>,
-    omega: f64,
-    out: MatMut<'_, f64>,
-) {
-    add_constraint_term_lower(model, vertices, omega, out);
-}
-
-/// `out += omega^2 (Phi W_x)^T (Phi W_x)` on the lower triangle of the `4N x 4N` `out` (the
-/// `4 x 4` blocks on the diagonal are updated whole).
+/// `out += omega^2 (Phi W_x)^T (Phi W_x)` over the rows of `vertices`, on the lower triangle of the
+/// `4N x 4N` `out` (the `4 x 4` blocks on the diagonal are updated whole): the constraint term of
+/// eq 26 added vertex by vertex, in the given order, so a matrix that already holds the term of some
+/// regions grows to the same bits as one built whole.
 ///
 /// Row `k` of `Phi W_x` is `w_k (x) (x_k, 1)`: per isoline `m` of vertex `k`, 4 contiguous
 /// columns. Only the blocks of isoline pairs `(p, q)` with `p >= q` are accumulated, 4 wide.
-fn add_constraint_term_lower(
+pub fn add_constraint_rows_lower(
     model: &IsolineModel,
     vertices: impl Iterator<Item = u32>,
     omega: f64,

@@ -36,10 +36,20 @@ pub fn cotangent_weights(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Cota
 /// `L_ii = -sum_j L_ij`, so `L 1 = 0` and `-L` is positive semi-definite (libigl's `cotmatrix`).
 /// Rows and columns are sorted (CSC), duplicates summed.
 pub fn cotan_laplacian(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> SparseColMat<usize, f64> {
-    let n = positions.len();
-    let weights = cotangent_weights(positions, triangles);
+    laplacian_from_corner_weights(positions.len(), triangles, &cotangent_weights(positions, triangles))
+}
+
+/// The `n x n` Laplacian of `#F x 3` `triangles` whose corner `k` of face `f` carries the weight
+/// `weights[f][k]` of the opposite edge: `L_ij` = sum of the weights of the edges between `i` and
+/// `j` (parallel edges summed), `L_ii = -sum_j L_ij`, CSC with sorted rows. A self-edge (`i == j`)
+/// adds `c + c - c - c = 0` to `L_ii`. Panics on an index `>= n` (callers hold validated meshes).
+pub(super) fn laplacian_from_corner_weights(
+    n: usize,
+    triangles: &[[u32; 3]],
+    weights: &[[f64; 3]],
+) -> SparseColMat<usize, f64> {
     let mut entries = Vec::with_capacity(12 * triangles.len());
-    for (t, w) in triangles.iter().zip(&weights) {
+    for (t, w) in triangles.iter().zip(weights) {
         for k in 0..3 {
             let i = t[(k + 1) % 3] as usize;
             let j = t[(k + 2) % 3] as usize;
@@ -50,5 +60,6 @@ pub fn cotan_laplacian(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Sparse
             entries.push(Triplet::new(j, j, -c));
         }
     }
-    SparseColMat::try_new_from_triplets(n, n, &entries).expect("indices are in range by TriMesh's invariants")
+    SparseColMat::try_new_from_triplets(n, n, &entries)
+        .expect("indices are in range by the mesh's invariants")
 }

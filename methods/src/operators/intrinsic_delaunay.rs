@@ -26,7 +26,7 @@
 
 use std::collections::VecDeque;
 
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::SparseColMat;
 use meshes::vector::{norm, sub};
 
 use super::{MassKind, DEGENERATE_FACE_RATIO};
@@ -190,22 +190,11 @@ impl IntrinsicTriangulation {
     /// [`super::cotan_laplacian`]: `L_ij` = sum of the weights of the edges between `i` and `j`
     /// (parallel edges summed), `L_ii = -sum_j L_ij`, CSC with sorted rows.
     pub fn cotan_laplacian(&self) -> SparseColMat<usize, f64> {
-        let weights = self.cotangent_weights();
-        let mut entries = Vec::with_capacity(12 * self.triangles.len());
-        for (t, w) in self.triangles.iter().zip(&weights) {
-            for k in 0..3 {
-                let i = t[(k + 1) % 3] as usize;
-                let j = t[(k + 2) % 3] as usize;
-                let c = w[k];
-                // A self-edge (i == j) adds c + c - c - c = 0 to L_ii.
-                entries.push(Triplet::new(i, j, c));
-                entries.push(Triplet::new(j, i, c));
-                entries.push(Triplet::new(i, i, -c));
-                entries.push(Triplet::new(j, j, -c));
-            }
-        }
-        SparseColMat::try_new_from_triplets(self.n_vertices, self.n_vertices, &entries)
-            .expect("indices are checked by from_mesh")
+        super::cotan::laplacian_from_corner_weights(
+            self.n_vertices,
+            &self.triangles,
+            &self.cotangent_weights(),
+        )
     }
 
     /// `#V` diagonal of the lumped mass matrix on the intrinsic triangles (as [`super::lumped_mass`]:
