@@ -366,6 +366,31 @@ impl IsolineModel {
             .flat_map(move |&(m, w)| (0..4).map(move |c| (4 * m as usize + c, w * h[c])))
     }
 
+    /// The transforms `R` (`4N x 3`) whose `W_x R` is nearest to `target` (`#V x 3`) in least
+    /// squares over every vertex: how well the reduced space can represent a shape at all. A tiny
+    /// ridge (1e-12 of the largest diagonal entry) keeps transforms no vertex sees determined.
+    pub fn least_squares_fit(&self, target: &[[f64; 3]]) -> Mat<f64> {
+        let size = 4 * self.n_isolines();
+        let mut normal = Mat::<f64>::zeros(size, size);
+        let mut rhs = Mat::<f64>::zeros(size, 3);
+        for (k, t) in target.iter().enumerate() {
+            let row: Vec<(usize, f64)> = self.position_row(k).collect();
+            for &(p, vp) in &row {
+                for &(q, vq) in &row {
+                    normal[(p, q)] += vp * vq;
+                }
+                for a in 0..3 {
+                    rhs[(p, a)] += vp * t[a];
+                }
+            }
+        }
+        let ridge = 1e-12 * (0..size).map(|i| normal[(i, i)]).fold(0.0, f64::max);
+        for i in 0..size {
+            normal[(i, i)] += ridge;
+        }
+        normal.llt(faer::Side::Lower).map(|llt| faer::linalg::solvers::Solve::solve(&llt, &rhs)).unwrap_or_else(|_| Mat::zeros(size, 3))
+    }
+
     /// `W_delta` row `k`: `(column, value)` pairs.
     fn delta_row(&self, k: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
         let d = self.base_delta[k];
