@@ -222,10 +222,10 @@ fn manifold_harmonics_match_scipy_eigsh() {
             let values: Vec<f64> = read_rows(&out).into_iter().map(|r| r[0]).collect();
             let rows = read_rows(&out.with_extension("txt.vectors"));
             let reference = faer::Mat::from_fn(rows.len(), k + EXTRA, |i, j| rows[i][j]);
-            let ours = methods::spectral::smallest_eigenpairs(
+            let ours = methods::linalg::spectral::smallest_eigenpairs(
                 stiffness.as_ref(),
                 &mass,
-                &methods::spectral::EigenOptions::new(k),
+                &methods::linalg::spectral::EigenOptions::new(k),
             )
             .unwrap();
             assert_eq!(ours.constant_mode, Some(0), "{name}: constant mode not flagged");

@@ -14,8 +14,8 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholeskyRaw};
 use faer::{Conj, Mat, Par, Side};
+use methods::linalg::sparse_cholesky::{add_to_diagonal, SparseCholesky};
 use methods::operators::{cotan_laplacian, lumped_mass, MassKind};
-use methods::sparse_cholesky::{add_to_diagonal, SparseCholesky};
 
 /// Best and median milliseconds per call of `f`, repeated for about `budget` seconds.
 fn time(mut f: impl FnMut(), budget: f64) -> (f64, f64) {

@@ -5,8 +5,8 @@
 
 use std::time::Instant;
 
+use methods::linalg::spectral::{smallest_eigenpairs, EigenOptions};
 use methods::operators::{cotan_laplacian, lumped_mass, MassKind};
-use methods::spectral::{smallest_eigenpairs, EigenOptions};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();

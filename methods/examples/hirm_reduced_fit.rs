@@ -11,7 +11,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let rest = meshes::io::read_mesh(&args[1])?;
     let target = meshes::io::read_mesh(&args[2])?;
     if target.n_vertices() != rest.n_vertices() {
-        return Err(format!("{} has {} vertices, {} has {}", args[2], target.n_vertices(), args[1], rest.n_vertices()).into());
+        return Err(format!(
+            "{} has {} vertices, {} has {}",
+            args[2],
+            target.n_vertices(),
+            args[1],
+            rest.n_vertices()
+        )
+        .into());
     }
     let env = |k: &str, d: usize| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
     let defaults = methods::hirm::HirmParams::default();

@@ -44,10 +44,10 @@ use serde::Deserialize;
 
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets, FREE};
+use crate::linalg::sparse_cholesky::SparseCholesky;
 use crate::method::{finish_iteration, DeformationMethod, IterationObserver, SolveSummary};
 use crate::operators::{laplacian, LaplacianWeights};
 use crate::rotation_fit::{closest_rotation_warm, Mat3};
-use crate::sparse_cholesky::SparseCholesky;
 
 /// Parameters of [`Arap`] (configs/methods.toml, section `[arap]`).
 #[derive(Clone, Debug, Deserialize)]

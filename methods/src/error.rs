@@ -1,6 +1,6 @@
 //! Errors of the methods crate.
 
-use crate::sparse_cholesky::SolverError;
+use crate::linalg::sparse_cholesky::SolverError;
 
 /// Everything a deformation method can report instead of a result.
 #[derive(Debug, thiserror::Error)]
@@ -25,7 +25,7 @@ pub enum MethodError {
     #[error("intrinsic Delaunay triangulation: {0}")]
     IntrinsicDelaunay(crate::operators::IntrinsicDelaunayError),
     #[error("eigensolver: {0}")]
-    Eigen(crate::spectral::EigenError),
+    Eigen(crate::linalg::spectral::EigenError),
     #[error("`{method}` produced a non-finite position at vertex {vertex} in iteration {iteration}")]
     NonFinite { method: &'static str, vertex: usize, iteration: usize },
     #[error("`{method}` diverged: iteration {iteration} moved a vertex {step:.3e} bounding-box diagonals")]

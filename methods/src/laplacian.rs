@@ -34,9 +34,9 @@ use serde::Deserialize;
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
 use crate::laplacian_coordinates::RotationInvariantCoordinates;
+use crate::linalg::sparse_cholesky::{add_to_diagonal, SparseCholesky};
 use crate::method::{finish_iteration, DeformationMethod, IterationObserver, SolveSummary};
 use crate::operators::{laplacian, LaplacianWeights};
-use crate::sparse_cholesky::{add_to_diagonal, SparseCholesky};
 
 /// Parameters of [`LaplacianEditing`] (configs/methods.toml, section `[laplacian]`).
 #[derive(Clone, Debug, Deserialize)]
@@ -122,8 +122,10 @@ impl DeformationMethod for LaplacianEditing {
         let n = rest_mesh.n_vertices();
         let laplacian = laplacian(self.params.weights, positions, rest_mesh.triangles())?;
         // L is symmetric, so L^T L = L L. Rebuilt from triplets to get sorted columns.
-        let product = sparse_sparse_matmul(laplacian.as_ref(), laplacian.as_ref(), 1.0, Par::Seq)
-            .map_err(|e| MethodError::Solver(crate::sparse_cholesky::SolverError::Faer(format!("{e:?}"))))?;
+        let product =
+            sparse_sparse_matmul(laplacian.as_ref(), laplacian.as_ref(), 1.0, Par::Seq).map_err(|e| {
+                MethodError::Solver(crate::linalg::sparse_cholesky::SolverError::Faer(format!("{e:?}")))
+            })?;
         let normal_matrix = sorted(&product);
         self.cholesky = Some(SparseCholesky::analyze(normal_matrix.as_ref())?);
 

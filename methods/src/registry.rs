@@ -19,6 +19,8 @@ pub struct MethodEntry {
     pub summary: &'static str,
     /// Build the method from its parameter table (missing keys take the paper's defaults).
     pub create: fn(&toml::Table) -> Result<Box<dyn DeformationMethod>, MethodError>,
+    /// Whether `solve` iterates (takes `max_iterations` and `tolerance`); `false` for a direct solve.
+    pub iterative: bool,
 }
 
 /// Every method of the suite, in report order.
@@ -27,46 +29,55 @@ pub const METHODS: &[MethodEntry] = &[
         name: "laplacian",
         summary: "unreduced iterative Laplacian editing (Au et al. 2007 sec. 3, eq 1-3), the reference the reduced models approximate",
         create: |p| Ok(Box::new(LaplacianEditing::new(parse("laplacian", p)?)?)),
+        iterative: true,
     },
     MethodEntry {
         name: "arap",
         summary: "As-Rigid-As-Possible surface modeling (Sorkine & Alexa 2007), cotangent weights (intrinsic Delaunay by default), hard constraints",
         create: |p| Ok(Box::new(Arap::new(parse("arap", p)?)?)),
+        iterative: true,
     },
     MethodEntry {
         name: "hirm",
         summary: "handle-independent reduced model for incremental editing: isolines of Laplacian eigenvectors, background precompute (Wu, Au, Tai & Lu 2015)",
         create: |p| Ok(Box::new(Hirm::new(parse("hirm", p)?)?)),
+        iterative: true,
     },
     MethodEntry {
         name: "spectral_mhb",
         summary: "spectral mesh deformation in manifold harmonics bases with deformation transfer of details (Rong, Cao & Guo 2008)",
         create: |p| Ok(Box::new(SpectralMhb::new(parse("spectral_mhb", p)?)?)),
+        iterative: false,
     },
     MethodEntry {
         name: "scale_aware",
         summary: "scale-aware shape manipulation: triangle and edge angles, normals on the Gauss map, then G(Theta, N) V = 0 (Liu, Wang, Liu & Liu)",
         create: |p| Ok(Box::new(ScaleAware::new("scale_aware", parse("scale_aware", p)?)?)),
+        iterative: true,
     },
     MethodEntry {
         name: "scale_aware_ora",
         summary: "`scale_aware` followed by the optimal rigidity approximation: triangles rescaled to their rest areas and stitched (section 5.3)",
         create: |p| Ok(Box::new(ScaleAware::new("scale_aware_ora", parse("scale_aware_ora", p)?)?)),
+        iterative: true,
     },
     MethodEntry {
         name: "isolines",
         summary: "handle-aware isolines reduced model (Au, Fu, Tai & Cohen-Or 2007), n_iso = 20, isoline-interpolated Laplacian coordinates (Table 1 t_2)",
         create: |p| Ok(Box::new(Isolines::new("isolines", parse("isolines", p)?)?)),
+        iterative: true,
     },
     MethodEntry {
         name: "isolines_10",
         summary: "`isolines` with n_iso = 10 (the coarser model of Au et al. 2007, Fig. 9)",
         create: |p| Ok(Box::new(Isolines::new("isolines_10", parse("isolines_10", p)?)?)),
+        iterative: true,
     },
     MethodEntry {
         name: "isolines_t1",
         summary: "`isolines` with vertex interpolation only: Laplacian coordinates on the whole mesh per iteration (Au et al. 2007 eq 6, Table 1 t_1)",
         create: |p| Ok(Box::new(Isolines::new("isolines_t1", parse("isolines_t1", p)?)?)),
+        iterative: true,
     },
 ];
 

@@ -4,7 +4,7 @@
 
 use meshes::shapes::{generate, ShapeKind};
 use meshes::{AffineTransform, TriMesh, VertexStatus};
-use methods::isolines::tracing::trace_isoline;
+use methods::isoline_model::tracing::trace_isoline;
 use methods::isolines::{harmonic_fields, Isolines, IsolinesParams, LaplacianCoordinates};
 use methods::operators::cotan_laplacian;
 use methods::{DeformationMethod, HandleRegion, HandleSet, HandleTargets, MethodError, NoObserver};

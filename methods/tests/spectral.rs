@@ -4,10 +4,10 @@
 
 use faer::Mat;
 use meshes::shapes::{generate, ShapeKind};
-use methods::operators::{cotan_laplacian, lumped_mass, MassKind};
-use methods::spectral::{
+use methods::linalg::spectral::{
     inverse_transform, smallest_eigenpairs, transform, EigenError, EigenOptions, Eigenpairs,
 };
+use methods::operators::{cotan_laplacian, lumped_mass, MassKind};
 
 fn problem(kind: ShapeKind, vertices: usize) -> (faer::sparse::SparseColMat<usize, f64>, Vec<f64>) {
     let mesh = generate(kind, vertices).unwrap().mesh;
@@ -90,7 +90,7 @@ fn krylov_schur_matches_the_dense_solver() {
 #[test]
 fn stiffness_without_a_null_vector_is_solved_without_deflation() {
     let (q, mass) = problem(ShapeKind::Cactus, 1500);
-    let shifted = methods::sparse_cholesky::add_to_diagonal(q.as_ref(), &mass);
+    let shifted = methods::linalg::sparse_cholesky::add_to_diagonal(q.as_ref(), &mass);
     let count = 24;
     let laplacian = smallest_eigenpairs(q.as_ref(), &mass, &krylov(count)).unwrap();
     let ours = smallest_eigenpairs(shifted.as_ref(), &mass, &krylov(count)).unwrap();

@@ -132,7 +132,10 @@ fn eigensolver_failure_is_an_eigensolver_error() {
     assert!(
         matches!(
             e,
-            methods::MethodError::Eigen(methods::spectral::EigenError::NotConverged { wanted: 9, .. })
+            methods::MethodError::Eigen(methods::linalg::spectral::EigenError::NotConverged {
+                wanted: 9,
+                ..
+            })
         ),
         "{e:?}"
     );

@@ -19,7 +19,7 @@ use faer::Mat;
 
 use crate::error::MethodError;
 use crate::handles::{HandleRegion, HandleSet};
-use crate::isolines::{add_constraint_rows_lower, HandleIndependentSystem, IsolineModel, SetBlend};
+use crate::isoline_model::{add_constraint_rows_lower, HandleIndependentSystem, IsolineModel, SetBlend};
 
 /// What the handle-independent system is built from besides the base shape: fixed for a rest mesh.
 pub struct SystemInputs {

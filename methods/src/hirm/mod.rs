@@ -85,7 +85,7 @@ pub use propagation_fields::{propagation_fields, select_fields, PropagationField
 
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
-use crate::isolines::{
+use crate::isoline_model::{
     add_constraint_rows_lower, checked_positions, constraint_rhs, finish_reduced_iteration, ReducedIteration,
     RotationFit,
 };
@@ -403,7 +403,7 @@ impl DeformationMethod for Hirm {
             MemStack::new(&mut self.factor_workspace),
             Default::default(),
         )
-        .map_err(|_| MethodError::Solver(crate::sparse_cholesky::SolverError::NotPositiveDefinite))?;
+        .map_err(|_| MethodError::Solver(crate::linalg::sparse_cholesky::SolverError::NotPositiveDefinite))?;
         self.set_timing("t_h_handle_update", start.elapsed().as_secs_f64());
         self.reduced = independent.model.identity_transforms();
         self.bound = Some(Bound { independent, handles: handles.clone() });

@@ -2,7 +2,7 @@
 //!
 //! The fields are the first non-constant eigenvectors of the Laplacian of the rest mesh,
 //! `Q e = lambda D e` with `Q = -L` and the barycentric lumped mass `D` (the manifold harmonics of
-//! [`crate::spectral`]), selected by the score `S_i = sqrt(lambda_i / lambda_2) < phi` (eq 1–2).
+//! [`crate::linalg::spectral`]), selected by the score `S_i = sqrt(lambda_i / lambda_2) < phi` (eq 1–2).
 //!
 //! Decisions:
 //! - Eigenvectors are `D`-orthonormal, so the spectral coefficients of eq 7 are the manifold
@@ -14,8 +14,8 @@ use faer::sparse::SparseColMat;
 use faer::Mat;
 
 use crate::error::MethodError;
+use crate::linalg::spectral::{smallest_eigenpairs, transform, EigenOptions};
 use crate::operators::{lumped_mass, MassKind};
-use crate::spectral::{smallest_eigenpairs, transform, EigenOptions};
 
 /// The selected fields of a rest mesh.
 #[derive(Clone, Debug)]

@@ -388,7 +388,10 @@ impl IsolineModel {
         for i in 0..size {
             normal[(i, i)] += ridge;
         }
-        normal.llt(faer::Side::Lower).map(|llt| faer::linalg::solvers::Solve::solve(&llt, &rhs)).unwrap_or_else(|_| Mat::zeros(size, 3))
+        normal
+            .llt(faer::Side::Lower)
+            .map(|llt| faer::linalg::solvers::Solve::solve(&llt, &rhs))
+            .unwrap_or_else(|_| Mat::zeros(size, 3))
     }
 
     /// `W_delta` row `k`: `(column, value)` pairs.

@@ -11,7 +11,7 @@ use faer::Mat;
 
 use crate::error::MethodError;
 use crate::handles::{HandleSet, FREE};
-use crate::sparse_cholesky::SparseCholesky;
+use crate::linalg::sparse_cholesky::SparseCholesky;
 
 /// `#V x #handles` harmonic fields, column `i` equal to 1 on handle `i` and 0 on the others.
 ///
@@ -62,8 +62,9 @@ pub fn harmonic_fields(
             }
         }
     }
-    let system = SparseColMat::try_new_from_triplets(n_free, n_free, &entries)
-        .map_err(|e| MethodError::Solver(crate::sparse_cholesky::SolverError::Faer(format!("{e:?}"))))?;
+    let system = SparseColMat::try_new_from_triplets(n_free, n_free, &entries).map_err(|e| {
+        MethodError::Solver(crate::linalg::sparse_cholesky::SolverError::Faer(format!("{e:?}")))
+    })?;
     let mut cholesky = SparseCholesky::new(system.as_ref()).map_err(|_| {
         MethodError::Handles(
             "harmonic fields: a connected part of the mesh has no handle vertex (the Laplace equation is singular there)"

@@ -17,7 +17,7 @@ use faer::Mat;
 use meshes::geometry::triangle_area;
 use meshes::vector::{add, scale, sub};
 
-use crate::sparse_cholesky::{SolverError, SparseCholesky};
+use crate::linalg::sparse_cholesky::{SolverError, SparseCholesky};
 
 /// Eq 13–14: each triangle of `#V x 3` `positions` scaled about its centroid by
 /// `tau_t = sqrt(Area_t / Area'_t)` so that its area equals `rest_areas[t]`; `#F` triangles of

@@ -11,7 +11,7 @@ use faer::sparse::SparseColMat;
 use faer::Mat;
 
 use super::scale_aware_equations::ScaleAwareEquations;
-use crate::sparse_cholesky::{SolverError, SparseCholesky};
+use crate::linalg::sparse_cholesky::{SolverError, SparseCholesky};
 
 /// Time spent in step two during one `solve`, in seconds.
 #[derive(Clone, Copy, Debug, Default)]

@@ -14,8 +14,8 @@ use faer::Mat;
 use meshes::vector::{cross, dot, norm, scale, sub};
 
 use crate::error::MethodError;
+use crate::linalg::sparse_cholesky::SparseCholesky;
 use crate::rotation_fit::Mat3;
-use crate::sparse_cholesky::SparseCholesky;
 
 /// Precomputed detail-transfer system of a rest mesh.
 pub struct DeformationTransfer {

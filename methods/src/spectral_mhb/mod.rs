@@ -2,7 +2,7 @@
 //!
 //! Pipeline (the paper's section 1, steps 1–4), with the paper's timing names:
 //! 1. PT1 — manifold harmonics bases `H` (`#V x m`): the `m` smallest eigenpairs of `Q h = lambda D h`
-//!    (eq 5–6; `Q = -L_s`, `D` the barycentric lumped mass `D_ii = sum |t| / 3`), see [`crate::spectral`].
+//!    (eq 5–6; `Q = -L_s`, `D` the barycentric lumped mass `D_ii = sum |t| / 3`), see [`crate::linalg::spectral`].
 //! 2. The smoothed model `p~ = H H^T D p` (inverse MHT of the first `m` coefficients, eq 7–8).
 //! 3. PT2 — the reduced energy `S = H^T A H` of the thin-shell energy (eq 9–13), `A` from
 //!    `L = M^{-1} L_s` (eq 13, `M` the Voronoi areas): `A = -k_s L + k_b L^2`.
@@ -51,9 +51,9 @@ pub use local_frames::LocalFrameDetails;
 
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
+use crate::linalg::spectral::{smallest_eigenpairs, EigenOptions};
 use crate::method::{DeformationMethod, IterationObserver, IterationReport, SolveSummary};
 use crate::operators::{laplacian, lumped_mass_for, LaplacianWeights, MassKind};
-use crate::spectral::{smallest_eigenpairs, EigenOptions};
 
 /// How the handle constraints enter the reduced system.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
@@ -233,9 +233,10 @@ impl DeformationMethod for SpectralMhb {
         self.set_timing("pt1_manifold_harmonics", start.elapsed().as_secs_f64());
 
         // The smoothed model (eq 7–8).
-        let coefficients = crate::spectral::transform(self.basis.as_ref(), &mhb_mass, to_mat(p).as_ref());
+        let coefficients =
+            crate::linalg::spectral::transform(self.basis.as_ref(), &mhb_mass, to_mat(p).as_ref());
         self.smoothed_rest =
-            to_rows(&crate::spectral::inverse_transform(self.basis.as_ref(), coefficients.as_ref()));
+            to_rows(&crate::linalg::spectral::inverse_transform(self.basis.as_ref(), coefficients.as_ref()));
 
         // PT2: S = H^T (-k_s L_s + k_b L_s M^{-1} L_s) H.
         let start = Instant::now();
@@ -392,7 +393,8 @@ impl DeformationMethod for SpectralMhb {
 
         // RT2: the deformed smoothed model, then the details.
         let t = Instant::now();
-        let displacement_field = crate::spectral::inverse_transform(self.basis.as_ref(), spectral.as_ref());
+        let displacement_field =
+            crate::linalg::spectral::inverse_transform(self.basis.as_ref(), spectral.as_ref());
         self.smoothed_deformed = (0..self.rest.len())
             .map(|i| std::array::from_fn(|a| self.smoothed_rest[i][a] + displacement_field[(i, a)]))
             .collect();

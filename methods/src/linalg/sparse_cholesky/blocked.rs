@@ -27,8 +27,8 @@
 use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
 
 #[cfg(target_arch = "x86_64")]
-use crate::row_major::Fused;
-use crate::row_major::{combine, fma_available, reduce, row, row_mut, MulAdd, Separate};
+use crate::linalg::row_major::Fused;
+use crate::linalg::row_major::{combine, fma_available, reduce, row, row_mut, MulAdd, Separate};
 
 /// Layout of `L` plus the gather map from faer's value array.
 #[derive(Debug, Default)]
@@ -221,7 +221,7 @@ unsafe fn solve_avx2_fma<const K: usize, const NA: usize, const LB: usize>(f: &B
     solve::<K, NA, LB, Fused>(f, x);
 }
 
-/// `sum_r coef[r] * x[rows[r] - offset, :]`, like [`combine`](crate::row_major::combine) but gathering the rows of `x`.
+/// `sum_r coef[r] * x[rows[r] - offset, :]`, like [`combine`](crate::linalg::row_major::combine) but gathering the rows of `x`.
 #[inline(always)]
 fn gather_combine<const K: usize, const NA: usize, M: MulAdd>(
     coef: &[f64],

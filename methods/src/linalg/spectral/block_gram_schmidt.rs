@@ -16,8 +16,8 @@ use faer::{Accum, Mat, MatMut, MatRef, Par};
 
 use super::random::SplitMix64;
 #[cfg(target_arch = "x86_64")]
-use crate::row_major::Fused;
-use crate::row_major::{combine, fma_available, row_mut, MulAdd, Separate};
+use crate::linalg::row_major::Fused;
+use crate::linalg::row_major::{combine, fma_available, row_mut, MulAdd, Separate};
 
 /// Rows of `W` processed together: a `ROWS x K` row-major chunk (8 KiB for `K = 4`) stays in L1
 /// while the columns of `V` stream past it.

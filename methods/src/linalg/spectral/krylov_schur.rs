@@ -20,7 +20,7 @@ use faer::{Accum, Mat, Par, Side};
 use super::block_gram_schmidt::{column_norms, orthonormalize_block, project_out, Projector};
 use super::random::SplitMix64;
 use super::{EigenError, EigenOptions, Eigenpairs};
-use crate::sparse_cholesky::{add_to_diagonal, SparseCholesky};
+use crate::linalg::sparse_cholesky::{add_to_diagonal, SparseCholesky};
 
 /// Relative size of the shift: `sigma = -SHIFT * (upper bound of the spectrum)`. Small enough that the
 /// wanted eigenvalues are well separated after inversion, large enough to keep `Q - sigma D` safely

@@ -19,7 +19,7 @@ pub use transform::{inverse_transform, transform};
 use faer::sparse::SparseColMatRef;
 use faer::Mat;
 
-use crate::sparse_cholesky::SolverError;
+use crate::linalg::sparse_cholesky::SolverError;
 
 /// Options of [`smallest_eigenpairs`].
 #[derive(Clone, Debug)]

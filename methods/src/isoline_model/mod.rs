@@ -1,0 +1,129 @@
+//! The isoline reduced model shared by `isolines` (Au et al. 2007) and `hirm` (Wu et al. 2015):
+//! isolines traced on scalar fields ([`tracing`]), one 3x4 transform per isoline interpolated to
+//! the vertices and the Laplacian coordinates ([`interpolation`]: `X = W_x R_x`,
+//! `delta = W_delta R_delta`), the handle-independent and constrained reduced systems, and the
+//! end of one reduced iteration (solve, move the sampled triangles, check, report).
+//!
+//! What the two methods differ in stays with them: where the fields come from (harmonic fields
+//! per handle, Laplacian eigenvectors), how the sets are blended ([`SetBlend`]) and how isoline
+//! rotations are fitted ([`RotationFit`]).
+
+pub mod interpolation;
+pub mod tracing;
+
+use std::time::Instant;
+
+use faer::{Mat, MatRef};
+use meshes::vector::{cross, dot, normalize_or_zero, scale, sub};
+
+pub use interpolation::{
+    add_constraint_rows_lower, constraint_rhs, HandleIndependentSystem, IsolineModel, ReducedSystem,
+    RotationFit, SetBlend,
+};
+
+use crate::error::MethodError;
+use crate::method::{IterationObserver, IterationReport, SolveSummary};
+
+/// What [`finish_reduced_iteration`] needs to know of the iteration and the bound model.
+pub(crate) struct ReducedIteration<'a> {
+    pub method: &'static str,
+    /// 0-based index within the solve.
+    pub iteration: usize,
+    /// When the iteration's own work started.
+    pub start: Instant,
+    pub model: &'a IsolineModel,
+    /// `L` of `U^T U = L L^T` (lower triangle; the strict upper one is not read).
+    pub factor: MatRef<'a, f64>,
+}
+
+/// A step (largest vertex displacement of one iteration, in rest bbox diagonals) beyond which a
+/// reduced solve has diverged. The first iteration moves from the start to the targets and may be
+/// as long as the edit; every later one only relaxes the shape towards its rotations, by a small
+/// fraction of the model. An iteration that moves a vertex by the size of the whole model is a
+/// runaway (as `hirm` on a 43K-vertex scan, which ended 29 diagonals away), not a relaxation.
+pub(crate) const DIVERGED_STEP: f64 = 1.0;
+
+/// `Err(Diverged)` when iteration `iteration` (0-based) of `method` made a step beyond
+/// [`DIVERGED_STEP`] (the first iteration is exempt).
+pub(crate) fn check_divergence(method: &'static str, iteration: usize, step: f64) -> Result<(), MethodError> {
+    if iteration >= 1 && step > DIVERGED_STEP {
+        return Err(MethodError::Diverged { method, iteration, step });
+    }
+    Ok(())
+}
+
+/// The end of one iteration of an isoline reduced model (Au et al. 2007 eq 10, HIRM eq 20): solve
+/// `U^T U R = rhs` (`4N x 3`) into `reduced`, move the probe vertices (`probes`, the sampled
+/// triangles' corners) and check them, report the step (largest probe displacement over `diagonal`)
+/// and the iteration time to `observer`. Returns the summary so far and whether to stop (converged
+/// below `tolerance`, or the observer asked).
+pub(crate) fn finish_reduced_iteration(
+    it: ReducedIteration<'_>,
+    mut rhs: Mat<f64>,
+    reduced: &mut Mat<f64>,
+    probes: &mut Vec<[f64; 3]>,
+    diagonal: f64,
+    tolerance: f64,
+    observer: &mut dyn IterationObserver,
+) -> Result<(SolveSummary, bool), MethodError> {
+    faer::linalg::cholesky::llt::solve::solve_in_place_with_conj(
+        it.factor,
+        faer::Conj::No,
+        rhs.as_mut(),
+        faer::Par::Seq,
+        faer::dyn_stack::MemStack::new(&mut []),
+    );
+    *reduced = rhs;
+    let next = it.model.probe_positions(reduced.as_ref());
+    if let Some(i) = next.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+        let vertex = it.model.probe_vertex(i) as usize;
+        return Err(MethodError::NonFinite { method: it.method, vertex, iteration: it.iteration });
+    }
+    let step = crate::method::max_displacement(probes, &next) / diagonal;
+    check_divergence(it.method, it.iteration, step)?;
+    *probes = next;
+    let report = IterationReport { iteration: it.iteration, step, seconds: it.start.elapsed().as_secs_f64() };
+    let summary =
+        SolveSummary { iterations: it.iteration + 1, converged: step < tolerance, final_step: step };
+    let (model, reduced) = (it.model, &*reduced);
+    let flow = observer.on_iteration(&report, &|| model.positions(reduced.as_ref()));
+    Ok((summary, summary.converged || flow.is_break()))
+}
+
+#[cfg(test)]
+mod divergence_tests {
+    use super::*;
+
+    #[test]
+    fn a_runaway_step_after_the_first_iteration_is_a_divergence_error() {
+        assert!(check_divergence("hirm", 0, 5.0).is_ok(), "the first iteration moves to the targets");
+        assert!(check_divergence("hirm", 7, 0.5).is_ok());
+        let e = check_divergence("hirm", 7, 29.0).unwrap_err();
+        assert!(matches!(e, MethodError::Diverged { method: "hirm", iteration: 7, .. }));
+        assert!(e.to_string().contains("`hirm` diverged: iteration 7"), "{e}");
+    }
+}
+
+/// `W_x R_x` for every vertex (`#V x 3`), or the first non-finite vertex as an error.
+pub(crate) fn checked_positions(
+    method: &'static str,
+    model: &IsolineModel,
+    reduced: MatRef<'_, f64>,
+    iterations: usize,
+) -> Result<Vec<[f64; 3]>, MethodError> {
+    let positions = model.positions(reduced);
+    match positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+        Some(vertex) => Err(MethodError::NonFinite { method, vertex, iteration: iterations }),
+        None => Ok(positions),
+    }
+}
+
+/// Orthonormal frame (normal, segment direction, their cross product) of a crossed triangle with
+/// corners `p` and the isoline segment from `q0` to `q1`, as the columns of a 3x3 matrix.
+pub(crate) fn segment_frame(p: [[f64; 3]; 3], q0: [f64; 3], q1: [f64; 3]) -> [[f64; 3]; 3] {
+    let normal = normalize_or_zero(cross(sub(p[1], p[0]), sub(p[2], p[0])));
+    let along = sub(q1, q0);
+    // Remove any normal component rounding left, so the frame stays orthonormal.
+    let along = normalize_or_zero(sub(along, scale(normal, dot(along, normal))));
+    [normal, along, cross(normal, along)]
+}

@@ -1,0 +1,7 @@
+//! The numerics the methods share, which import only each other and faer: the sparse Cholesky
+//! factorization and its blocked variant ([`sparse_cholesky`]), the symmetric eigensolvers
+//! ([`spectral`]: Krylov–Schur with shift-invert, dense), and row-major dense storage for hot loops.
+
+pub(crate) mod row_major;
+pub mod sparse_cholesky;
+pub mod spectral;
