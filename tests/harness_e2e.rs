@@ -204,7 +204,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
                 .as_array()
                 .unwrap()
                 .iter()
-                .find(|s| s[0] == "n_field")
+                .find(|s| s[0] == methods::keys::statistic::N_FIELD)
                 .map(|s| s[1].as_f64().unwrap())
         })
         .collect::<Vec<_>>();

@@ -71,7 +71,10 @@ pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, H
     }
     let handle_scenarios: Vec<&CaseResult> = results
         .iter()
-        .filter(|r| r.scenario.ends_with("-handles") && (r.method == "hirm" || r.method == "isolines"))
+        .filter(|r| {
+            r.scenario.ends_with("-handles")
+                && (r.method == methods::registry::HIRM || r.method == methods::registry::ISOLINES)
+        })
         .collect();
     if !handle_scenarios.is_empty() {
         written.extend(save(dir, "table1", &Plot::Table1(&handle_scenarios))?);
@@ -523,8 +526,11 @@ fn draw_table1<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult]) ->
         c.steps
             .iter()
             .filter_map(|s| {
-                let seconds = if c.method == "hirm" {
-                    s.phase_timings.iter().find(|(k, _)| k == "t_h_handle_update").map(|(_, v)| *v)?
+                let seconds = if c.method == methods::registry::HIRM {
+                    s.phase_timings
+                        .iter()
+                        .find(|(k, _)| k == methods::keys::phase::T_H_HANDLE_UPDATE)
+                        .map(|(_, v)| *v)?
                 } else {
                     s.bind_s
                 };

@@ -178,10 +178,10 @@ pub fn render_handle_updates(results: &[CaseResult]) -> Result<Vec<u8>, HarnessE
                 s.handles.to_string(),
                 s.constrained_vertices.to_string(),
                 ms(Some(s.bind_s)),
-                ms(phase(&s.phase_timings, "t_h_handle_update")),
-                ms(phase(&s.phase_timings, "bind_background_wait")),
-                ms(phase(&s.phase_timings, "t_b_background_precompute")),
-                ms(phase(&s.phase_timings, "t_e_propagation_fields")),
+                ms(phase(&s.phase_timings, methods::keys::phase::T_H_HANDLE_UPDATE)),
+                ms(phase(&s.phase_timings, methods::keys::phase::BIND_BACKGROUND_WAIT)),
+                ms(phase(&s.phase_timings, methods::keys::phase::T_B_BACKGROUND_PRECOMPUTE)),
+                ms(phase(&s.phase_timings, methods::keys::phase::T_E_PROPAGATION_FIELDS)),
                 ms(Some(s.median_iteration_ms / 1e3)),
                 s.iterations.to_string(),
             ])
@@ -204,22 +204,25 @@ pub fn render_table1(results: &[CaseResult]) -> String {
     );
     let stat =
         |r: &CaseResult, name: &str| phase(&r.statistics, name).map_or("-".to_string(), |v| format!("{v}"));
-    for hirm in results.iter().filter(|r| r.method == "hirm") {
-        let Some(isolines) = results.iter().find(|r| r.method == "isolines" && r.scenario == hirm.scenario)
+    for hirm in results.iter().filter(|r| r.method == methods::registry::HIRM) {
+        let Some(isolines) =
+            results.iter().find(|r| r.method == methods::registry::ISOLINES && r.scenario == hirm.scenario)
         else {
             continue;
         };
         for (h, i) in hirm.steps.iter().zip(&isolines.steps) {
-            let t_h = phase(&h.phase_timings, "t_h_handle_update").unwrap_or(f64::NAN);
-            let t_e = phase(&h.phase_timings, "t_e_propagation_fields").unwrap_or(f64::NAN);
-            let t_b = phase(&h.phase_timings, "t_b_background_precompute").unwrap_or(f64::NAN);
+            let t_h = phase(&h.phase_timings, methods::keys::phase::T_H_HANDLE_UPDATE).unwrap_or(f64::NAN);
+            let t_e =
+                phase(&h.phase_timings, methods::keys::phase::T_E_PROPAGATION_FIELDS).unwrap_or(f64::NAN);
+            let t_b =
+                phase(&h.phase_timings, methods::keys::phase::T_B_BACKGROUND_PRECOMPUTE).unwrap_or(f64::NAN);
             out.push_str(&format!(
                 "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.2} | {:.1} | {:.3} | {:.3} |\n",
                 hirm.scenario,
                 h.step,
                 h.handles,
-                stat(hirm, "n_field"),
-                stat(hirm, "n_t"),
+                stat(hirm, methods::keys::statistic::N_FIELD),
+                stat(hirm, methods::keys::statistic::N_T),
                 t_e,
                 t_b,
                 1e3 * t_h,

@@ -45,15 +45,15 @@ impl fmt::Display for Shard {
 /// four survey tests of a `harness all` on this project's 2-core machine (at 11f8f45). Only the
 /// ratios matter: they make `arap` and `scale_aware` count for a hundred `isolines`.
 const SECONDS_PER_KILOVERTEX: [(&str, f64); 9] = [
-    ("laplacian", 0.10),
-    ("arap", 0.25),
-    ("hirm", 0.043),
-    ("spectral_mhb", 0.039),
-    ("scale_aware", 0.48),
-    ("scale_aware_ora", 0.44),
-    ("isolines", 0.0042),
-    ("isolines_10", 0.0035),
-    ("isolines_t1", 0.0081),
+    (methods::registry::LAPLACIAN, 0.10),
+    (methods::registry::ARAP, 0.25),
+    (methods::registry::HIRM, 0.043),
+    (methods::registry::SPECTRAL_MHB, 0.039),
+    (methods::registry::SCALE_AWARE, 0.48),
+    (methods::registry::SCALE_AWARE_ORA, 0.44),
+    (methods::registry::ISOLINES, 0.0042),
+    (methods::registry::ISOLINES_10, 0.0035),
+    (methods::registry::ISOLINES_T1, 0.0081),
 ];
 
 /// Estimated cost of running `methods` on `scenario` (in seconds on the reference machine; a method

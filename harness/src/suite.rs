@@ -14,7 +14,7 @@ use crate::shard::{assign, estimated_cost, Shard};
 use crate::verdict::VerdictRules;
 
 /// The method every other is compared with (`rms_to_arap_over_diag`, `max_to_arap_over_diag`).
-pub const REFERENCE_METHOD: &str = "arap";
+pub const REFERENCE_METHOD: &str = methods::registry::ARAP;
 
 /// Environment variable naming the survey data directory (same as `--survey-dir`).
 pub const SURVEY_DIR_ENV: &str = "DEFORM_SURVEY_DIR";

@@ -19,7 +19,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for _ in 0..std::env::var("BINDS").map_or(5, |b| b.parse().unwrap()) {
         let t = std::time::Instant::now();
         hirm.bind_handles(&handles)?;
-        let th = hirm.phase_timings().into_iter().find(|(k, _)| *k == "t_h_handle_update").unwrap().1;
+        let th = hirm
+            .phase_timings()
+            .into_iter()
+            .find(|(k, _)| *k == methods::keys::phase::T_H_HANDLE_UPDATE)
+            .unwrap()
+            .1;
         println!("bind {:.3} ms, t_h {:.3} ms", t.elapsed().as_secs_f64() * 1e3, th * 1e3);
     }
     Ok(())

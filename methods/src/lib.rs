@@ -7,6 +7,7 @@ pub mod handles;
 pub mod hirm;
 pub mod isoline_model;
 pub mod isolines;
+pub mod keys;
 pub mod laplacian;
 mod laplacian_coordinates;
 pub mod linalg;

@@ -12,6 +12,18 @@ use crate::scale_aware::ScaleAware;
 use crate::spectral_mhb::SpectralMhb;
 
 /// One registered method.
+/// The registered method names, the one place they are spelled (entries below, the harness's
+/// reports and tables use these).
+pub const LAPLACIAN: &str = "laplacian";
+pub const ARAP: &str = "arap";
+pub const HIRM: &str = "hirm";
+pub const SPECTRAL_MHB: &str = "spectral_mhb";
+pub const SCALE_AWARE: &str = "scale_aware";
+pub const SCALE_AWARE_ORA: &str = "scale_aware_ora";
+pub const ISOLINES: &str = "isolines";
+pub const ISOLINES_10: &str = "isolines_10";
+pub const ISOLINES_T1: &str = "isolines_t1";
+
 pub struct MethodEntry {
     /// Name used in configs, on the command line and in reports.
     pub name: &'static str,
@@ -26,57 +38,57 @@ pub struct MethodEntry {
 /// Every method of the suite, in report order.
 pub const METHODS: &[MethodEntry] = &[
     MethodEntry {
-        name: "laplacian",
+        name: LAPLACIAN,
         summary: "unreduced iterative Laplacian editing (Au et al. 2007 sec. 3, eq 1-3), the reference the reduced models approximate",
-        create: |p| Ok(Box::new(LaplacianEditing::new(parse("laplacian", p)?)?)),
+        create: |p| Ok(Box::new(LaplacianEditing::new(parse(LAPLACIAN, p)?)?)),
         iterative: true,
     },
     MethodEntry {
-        name: "arap",
+        name: ARAP,
         summary: "As-Rigid-As-Possible surface modeling (Sorkine & Alexa 2007), cotangent weights (intrinsic Delaunay by default), hard constraints",
-        create: |p| Ok(Box::new(Arap::new(parse("arap", p)?)?)),
+        create: |p| Ok(Box::new(Arap::new(parse(ARAP, p)?)?)),
         iterative: true,
     },
     MethodEntry {
-        name: "hirm",
+        name: HIRM,
         summary: "handle-independent reduced model for incremental editing: isolines of Laplacian eigenvectors, background precompute (Wu, Au, Tai & Lu 2015)",
-        create: |p| Ok(Box::new(Hirm::new(parse("hirm", p)?)?)),
+        create: |p| Ok(Box::new(Hirm::new(parse(HIRM, p)?)?)),
         iterative: true,
     },
     MethodEntry {
-        name: "spectral_mhb",
+        name: SPECTRAL_MHB,
         summary: "spectral mesh deformation in manifold harmonics bases with deformation transfer of details (Rong, Cao & Guo 2008)",
-        create: |p| Ok(Box::new(SpectralMhb::new(parse("spectral_mhb", p)?)?)),
+        create: |p| Ok(Box::new(SpectralMhb::new(parse(SPECTRAL_MHB, p)?)?)),
         iterative: false,
     },
     MethodEntry {
-        name: "scale_aware",
+        name: SCALE_AWARE,
         summary: "scale-aware shape manipulation: triangle and edge angles, normals on the Gauss map, then G(Theta, N) V = 0 (Liu, Wang, Liu & Liu)",
-        create: |p| Ok(Box::new(ScaleAware::new("scale_aware", parse("scale_aware", p)?)?)),
+        create: |p| Ok(Box::new(ScaleAware::new(SCALE_AWARE, parse(SCALE_AWARE, p)?)?)),
         iterative: true,
     },
     MethodEntry {
-        name: "scale_aware_ora",
+        name: SCALE_AWARE_ORA,
         summary: "`scale_aware` followed by the optimal rigidity approximation: triangles rescaled to their rest areas and stitched (section 5.3)",
-        create: |p| Ok(Box::new(ScaleAware::new("scale_aware_ora", parse("scale_aware_ora", p)?)?)),
+        create: |p| Ok(Box::new(ScaleAware::new(SCALE_AWARE_ORA, parse(SCALE_AWARE_ORA, p)?)?)),
         iterative: true,
     },
     MethodEntry {
-        name: "isolines",
+        name: ISOLINES,
         summary: "handle-aware isolines reduced model (Au, Fu, Tai & Cohen-Or 2007), n_iso = 20, isoline-interpolated Laplacian coordinates (Table 1 t_2)",
-        create: |p| Ok(Box::new(Isolines::new("isolines", parse("isolines", p)?)?)),
+        create: |p| Ok(Box::new(Isolines::new(ISOLINES, parse(ISOLINES, p)?)?)),
         iterative: true,
     },
     MethodEntry {
-        name: "isolines_10",
+        name: ISOLINES_10,
         summary: "`isolines` with n_iso = 10 (the coarser model of Au et al. 2007, Fig. 9)",
-        create: |p| Ok(Box::new(Isolines::new("isolines_10", parse("isolines_10", p)?)?)),
+        create: |p| Ok(Box::new(Isolines::new(ISOLINES_10, parse(ISOLINES_10, p)?)?)),
         iterative: true,
     },
     MethodEntry {
-        name: "isolines_t1",
+        name: ISOLINES_T1,
         summary: "`isolines` with vertex interpolation only: Laplacian coordinates on the whole mesh per iteration (Au et al. 2007 eq 6, Table 1 t_1)",
-        create: |p| Ok(Box::new(Isolines::new("isolines_t1", parse("isolines_t1", p)?)?)),
+        create: |p| Ok(Box::new(Isolines::new(ISOLINES_T1, parse(ISOLINES_T1, p)?)?)),
         iterative: true,
     },
 ];

@@ -250,13 +250,19 @@ fn fields_grow_to_the_handle_count_and_at_least_min_fields_are_kept() {
     let params = HirmParams { min_fields: 3, fields_per_region: 3.0, max_fields: 8, ..HirmParams::default() };
     let mut hirm = Hirm::new(params).unwrap();
     hirm.precompute(&mesh).unwrap();
-    let n_field = |h: &Hirm| h.model_statistics().iter().find(|(k, _)| *k == "n_field").unwrap().1;
+    let n_field = |h: &Hirm| {
+        h.model_statistics().iter().find(|(k, _)| *k == methods::keys::statistic::N_FIELD).unwrap().1
+    };
     let selected = n_field(&hirm);
     assert!((3.0..6.0).contains(&selected), "min_fields 3, and the bar selects 5 by phi: {selected}");
     // Two regions x 3 = 6 fields: grown at this bind.
     hirm.bind_handles(&handles).unwrap();
     assert_eq!(n_field(&hirm), 6.0);
-    assert!(hirm.phase_timings().iter().any(|(k, _)| *k == "t_g_field_growth"), "{:?}", hirm.phase_timings());
+    assert!(
+        hirm.phase_timings().iter().any(|(k, _)| *k == methods::keys::phase::T_G_FIELD_GROWTH),
+        "{:?}",
+        hirm.phase_timings()
+    );
     let t = targets(&handles, &hirm.positions(), [0.0, 0.0, 0.1]);
     let summary = hirm.solve(&t, &mut NoObserver).unwrap();
     assert!(summary.converged, "{summary:?}");

@@ -180,7 +180,7 @@ fn ora_variant_runs_and_stays_near_the_handles() {
         .map(|(v, t)| norm(sub(result[v as usize], *t)))
         .fold(0.0, f64::max);
     assert!(residual < 1e-2 * mesh.bbox_diagonal(), "handle residual {residual}");
-    assert!(m.phase_timings().iter().any(|(k, _)| *k == "ora_stitching"));
+    assert!(m.phase_timings().iter().any(|(k, _)| *k == methods::keys::phase::ORA_STITCHING));
 }
 
 #[test]

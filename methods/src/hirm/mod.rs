@@ -248,7 +248,7 @@ impl Hirm {
             Some(Precomputed::Ready(m)) => m,
             Some(Precomputed::Running(worker)) => {
                 let model = Arc::new(worker.finish()?);
-                self.set_timing("t_b_background_precompute", model.seconds);
+                self.set_timing(crate::keys::phase::T_B_BACKGROUND_PRECOMPUTE, model.seconds);
                 model
             }
         };
@@ -292,7 +292,7 @@ impl Hirm {
         rest.scores = fields.scores;
         rest.capped = fields.capped;
         self.precomputed = Some(Precomputed::Ready(Arc::new(model)));
-        self.set_timing("t_g_field_growth", start.elapsed().as_secs_f64());
+        self.set_timing(crate::keys::phase::T_G_FIELD_GROWTH, start.elapsed().as_secs_f64());
         Ok(())
     }
 
@@ -328,7 +328,7 @@ impl DeformationMethod for Hirm {
             self.params.max_fields,
             self.params.seed,
         )?;
-        self.set_timing("t_e_propagation_fields", start.elapsed().as_secs_f64());
+        self.set_timing(crate::keys::phase::T_E_PROPAGATION_FIELDS, start.elapsed().as_secs_f64());
         let inputs = Arc::new(SystemInputs {
             triangles: rest.triangles().to_vec(),
             fields: fields.fields,
@@ -340,7 +340,7 @@ impl DeformationMethod for Hirm {
         });
         // The rest shape's system, synchronously: nothing to hide it behind yet.
         let model = handle_independent_model(rest.positions(), &inputs);
-        self.set_timing("t_b_background_precompute", model.seconds);
+        self.set_timing(crate::keys::phase::T_B_BACKGROUND_PRECOMPUTE, model.seconds);
         self.precomputed = Some(Precomputed::Ready(Arc::new(model)));
         self.rest = Some(Rest {
             positions: rest.positions().to_vec(),
@@ -365,7 +365,7 @@ impl DeformationMethod for Hirm {
         }
         let wait = Instant::now();
         let independent = self.handle_independent()?.expect("precompute leaves a model or a worker");
-        self.set_timing("bind_background_wait", wait.elapsed().as_secs_f64());
+        self.set_timing(crate::keys::phase::BIND_BACKGROUND_WAIT, wait.elapsed().as_secs_f64());
         // t_h: eq 26 and the factorization of U^T U. The factor's storage is overwritten, so the
         // previous handle set is unbound first: a failed update leaves no stale binding.
         self.bound = None;
@@ -404,7 +404,7 @@ impl DeformationMethod for Hirm {
             Default::default(),
         )
         .map_err(|_| MethodError::Solver(crate::linalg::sparse_cholesky::SolverError::NotPositiveDefinite))?;
-        self.set_timing("t_h_handle_update", start.elapsed().as_secs_f64());
+        self.set_timing(crate::keys::phase::T_H_HANDLE_UPDATE, start.elapsed().as_secs_f64());
         self.reduced = independent.model.identity_transforms();
         self.bound = Some(Bound { independent, handles: handles.clone() });
         Ok(())
@@ -460,8 +460,8 @@ impl DeformationMethod for Hirm {
         let worker = BackgroundPrecompute::start(current.clone(), rest.inputs.clone(), kept);
         self.current = current;
         self.precomputed = Some(Precomputed::Running(worker));
-        self.set_timing("solve_constraint_rhs", setup);
-        self.set_timing("solve_vertex_positions", positions_seconds);
+        self.set_timing(crate::keys::phase::SOLVE_CONSTRAINT_RHS, setup);
+        self.set_timing(crate::keys::phase::SOLVE_VERTEX_POSITIONS, positions_seconds);
         Ok(summary)
     }
 
@@ -476,12 +476,12 @@ impl DeformationMethod for Hirm {
     fn model_statistics(&self) -> Vec<(&'static str, f64)> {
         let mut out = Vec::new();
         if let Some(rest) = &self.rest {
-            out.push(("n_field", rest.scores.len() as f64));
-            out.push(("n_iso", self.params.isolines as f64));
+            out.push((crate::keys::statistic::N_FIELD, rest.scores.len() as f64));
+            out.push((crate::keys::statistic::N_ISO, self.params.isolines as f64));
             out.push(("fields_capped", f64::from(u8::from(rest.capped))));
         }
         if let Some(bound) = &self.bound {
-            out.push(("n_t", bound.independent.model.n_sampled_triangles() as f64));
+            out.push((crate::keys::statistic::N_T, bound.independent.model.n_sampled_triangles() as f64));
         }
         out
     }

@@ -196,7 +196,7 @@ impl DeformationMethod for Isolines {
         });
         self.bound = None;
         self.current = rest.positions().to_vec();
-        self.timings = vec![("precompute_laplacian", start.elapsed().as_secs_f64())];
+        self.timings = vec![(crate::keys::phase::PRECOMPUTE_LAPLACIAN, start.elapsed().as_secs_f64())];
         Ok(())
     }
 
@@ -251,11 +251,11 @@ impl DeformationMethod for Isolines {
         });
         let t3 = Instant::now();
         self.reduced = model.identity_transforms();
-        self.timings.retain(|(k, _)| *k == "precompute_laplacian");
+        self.timings.retain(|(k, _)| *k == crate::keys::phase::PRECOMPUTE_LAPLACIAN);
         self.timings.extend([
-            ("bind_harmonic_fields", (t1 - t0).as_secs_f64()),
-            ("bind_isolines", (t2 - t1).as_secs_f64()),
-            ("bind_reduced_system", (t3 - t2).as_secs_f64()),
+            (crate::keys::phase::BIND_HARMONIC_FIELDS, (t1 - t0).as_secs_f64()),
+            (crate::keys::phase::BIND_ISOLINES, (t2 - t1).as_secs_f64()),
+            (crate::keys::phase::BIND_REDUCED_SYSTEM, (t3 - t2).as_secs_f64()),
         ]);
         self.bound = Some(Bound { model, system, factor, handles: handles.clone(), coordinates });
         Ok(())
@@ -317,10 +317,10 @@ impl DeformationMethod for Isolines {
         }
         let t1 = Instant::now();
         self.current = checked_positions(name, &bound.model, self.reduced.as_ref(), summary.iterations)?;
-        self.timings.retain(|(k, _)| !k.starts_with("solve_"));
+        self.timings.retain(|(k, _)| !k.starts_with(crate::keys::phase::SOLVE_PREFIX));
         self.timings.extend([
-            ("solve_constraint_rhs", setup),
-            ("solve_vertex_positions", t1.elapsed().as_secs_f64()),
+            (crate::keys::phase::SOLVE_CONSTRAINT_RHS, setup),
+            (crate::keys::phase::SOLVE_VERTEX_POSITIONS, t1.elapsed().as_secs_f64()),
         ]);
         Ok(summary)
     }
@@ -335,7 +335,10 @@ impl DeformationMethod for Isolines {
 
     fn model_statistics(&self) -> Vec<(&'static str, f64)> {
         self.bound.as_ref().map_or_else(Vec::new, |b| {
-            vec![("n_isolines", b.model.n_isolines() as f64), ("n_tri", b.model.n_sampled_triangles() as f64)]
+            vec![
+                (crate::keys::statistic::N_ISOLINES, b.model.n_isolines() as f64),
+                (crate::keys::statistic::N_TRI, b.model.n_sampled_triangles() as f64),
+            ]
         })
     }
 }

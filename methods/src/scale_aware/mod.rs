@@ -450,22 +450,22 @@ impl DeformationMethod for ScaleAware {
     fn phase_timings(&self) -> Vec<(&'static str, f64)> {
         let t = &self.timings;
         let mut phases = vec![
-            ("initialization_laplacian", t.initialization),
-            ("step_one_normals", t.step_one_normals),
-            ("step_two_assembly", t.recovery.assembly_s),
-            ("step_two_refactorization", t.recovery.refactorization_s),
-            ("step_two_back_substitution", t.recovery.back_substitution_s),
+            (crate::keys::phase::INITIALIZATION_LAPLACIAN, t.initialization),
+            (crate::keys::phase::STEP_ONE_NORMALS, t.step_one_normals),
+            (crate::keys::phase::STEP_TWO_ASSEMBLY, t.recovery.assembly_s),
+            (crate::keys::phase::STEP_TWO_REFACTORIZATION, t.recovery.refactorization_s),
+            (crate::keys::phase::STEP_TWO_BACK_SUBSTITUTION, t.recovery.back_substitution_s),
         ];
         if self.params.optimal_rigidity {
-            phases.push(("ora_stitching", t.stitching));
+            phases.push((crate::keys::phase::ORA_STITCHING, t.stitching));
         }
         phases
     }
 
     fn model_statistics(&self) -> Vec<(&'static str, f64)> {
         vec![
-            ("outer_iterations", self.timings.outer_iterations as f64),
-            ("normal_iterations", self.timings.normal_iterations as f64),
+            (crate::keys::statistic::OUTER_ITERATIONS, self.timings.outer_iterations as f64),
+            (crate::keys::statistic::NORMAL_ITERATIONS, self.timings.normal_iterations as f64),
         ]
     }
 }

@@ -230,7 +230,7 @@ impl DeformationMethod for SpectralMhb {
         let pairs =
             smallest_eigenpairs(stiffness.as_ref(), &mhb_mass, &options).map_err(MethodError::Eigen)?;
         self.basis = pairs.vectors;
-        self.set_timing("pt1_manifold_harmonics", start.elapsed().as_secs_f64());
+        self.set_timing(crate::keys::phase::PT1_MANIFOLD_HARMONICS, start.elapsed().as_secs_f64());
 
         // The smoothed model (eq 7–8).
         let coefficients =
@@ -264,7 +264,7 @@ impl DeformationMethod for SpectralMhb {
         let mut s = Mat::<f64>::zeros(m, m);
         matmul(s.as_mut(), Accum::Replace, self.basis.transpose(), energy_h.as_ref(), 1.0, Par::rayon(0));
         self.reduced_energy = Mat::from_fn(m, m, |i, j| 0.5 * (s[(i, j)] + s[(j, i)]));
-        self.set_timing("pt2_reduced_energy", start.elapsed().as_secs_f64());
+        self.set_timing(crate::keys::phase::PT2_REDUCED_ENERGY, start.elapsed().as_secs_f64());
 
         // PT3: the detail system.
         let start = Instant::now();
@@ -279,7 +279,7 @@ impl DeformationMethod for SpectralMhb {
                 Details::Frames(LocalFrameDetails::new(p, &self.smoothed_rest, tris))
             }
         });
-        self.set_timing("pt3_detail_system", start.elapsed().as_secs_f64());
+        self.set_timing(crate::keys::phase::PT3_DETAIL_SYSTEM, start.elapsed().as_secs_f64());
 
         self.rest = p.to_vec();
         self.bbox_diagonal = rest.bbox_diagonal();
@@ -342,7 +342,7 @@ impl DeformationMethod for SpectralMhb {
             }
         };
         self.bound = Some(Bound { constrained, basis_rows, system });
-        self.set_timing("bind_reduced_system", start.elapsed().as_secs_f64());
+        self.set_timing(crate::keys::phase::BIND_REDUCED_SYSTEM, start.elapsed().as_secs_f64());
         Ok(())
     }
 
@@ -421,10 +421,10 @@ impl DeformationMethod for SpectralMhb {
         }
         let step = crate::method::max_displacement(&result, &self.current) / self.bbox_diagonal;
         self.current = result;
-        self.set_timing("rt1_constraint_rhs", rhs_seconds);
-        self.set_timing("rt1_reduced_solve", rt1);
-        self.set_timing("rt2_inverse_mht", inverse_mht);
-        self.set_timing("rt2_details", details);
+        self.set_timing(crate::keys::phase::RT1_CONSTRAINT_RHS, rhs_seconds);
+        self.set_timing(crate::keys::phase::RT1_REDUCED_SOLVE, rt1);
+        self.set_timing(crate::keys::phase::RT2_INVERSE_MHT, inverse_mht);
+        self.set_timing(crate::keys::phase::RT2_DETAILS, details);
         let report = IterationReport { iteration: 0, step, seconds: start.elapsed().as_secs_f64() };
         let current = &self.current;
         let _ = observer.on_iteration(&report, &|| current.clone());
