@@ -27,7 +27,16 @@
 //!   `e_ii = 0` and drops out.
 //!
 //! The initial guess is the current shape (the rest shape after `precompute`), as libigl's `arap_solve`
-//! with `U = V`, so the two can be compared iteration for iteration.
+//! with `U = V`, so the two can be compared iteration for iteration (`acceleration = "none"`).
+//!
+//! Acceleration (`acceleration`, default `anderson`): the local/global iteration is the fixed-point
+//! map `X <- G(X)` (local step on `X`, then the global solve), and Anderson acceleration (Peng, Deng,
+//! Zhang, Geng, Qin & Liu 2018, Algorithm 2, depth `anderson_depth`) extrapolates from the last
+//! steps. Their safeguard keeps the energy monotone: when the accelerated iterate's energy (with its
+//! own local-step rotations) exceeds the previous iterate's, it is replaced by the plain image
+//! `G(X_prev)` and the history is dropped. Convergence is judged on the plain step `|G(X) - X|`
+//! (the same quantity the plain iteration reports), and a converged solve returns `G(X)`, the global
+//! solution for the last rotations. The fixed points are those of the plain iteration.
 //!
 //! Phases: `precompute` builds the weights and the symbolic factorization of `-L`'s pattern;
 //! `bind_handles` does the numeric factorization of `-L` with the constrained rows and columns replaced
@@ -45,7 +54,8 @@ use serde::Deserialize;
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets, FREE};
 use crate::linalg::sparse_cholesky::SparseCholesky;
-use crate::method::{finish_iteration, DeformationMethod, IterationObserver, SolveSummary};
+use crate::linalg::anderson::AndersonAcceleration;
+use crate::method::{move_to, report_iteration, DeformationMethod, IterationObserver, SolveSummary};
 use crate::operators::{laplacian, LaplacianWeights};
 use crate::rotation_fit::{closest_rotation_warm, Mat3};
 
@@ -59,11 +69,32 @@ pub struct ArapParams {
     pub tolerance: f64,
     /// Spokes, weights and global-step matrix (see the module documentation, "Weights").
     pub weights: LaplacianWeights,
+    /// `"anderson"` (Peng et al. 2018) or `"none"` (the plain local/global iteration, libigl's).
+    pub acceleration: ArapAcceleration,
+    /// Steps of history Anderson acceleration extrapolates from (`m` of Peng et al.; at most 16).
+    pub anderson_depth: usize,
+}
+
+/// How the local/global iteration is driven (see the module documentation, "Acceleration").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ArapAcceleration {
+    /// Plain alternation, as Sorkine & Alexa 2007 and libigl's `arap_solve`.
+    None,
+    /// Anderson acceleration with the energy safeguard of Peng et al. 2018.
+    #[default]
+    Anderson,
 }
 
 impl Default for ArapParams {
     fn default() -> Self {
-        Self { max_iterations: 1000, tolerance: 1e-5, weights: LaplacianWeights::default() }
+        Self {
+            max_iterations: 1000,
+            tolerance: 1e-5,
+            weights: LaplacianWeights::default(),
+            acceleration: ArapAcceleration::default(),
+            anderson_depth: 5,
+        }
     }
 }
 
@@ -91,15 +122,23 @@ pub struct Arap {
     singular_frames: Vec<Mat3>,
     rhs_rows: Vec<[f64; 3]>,
     rhs: Mat<f64>,
+    /// `G(X)` of the current iterate and the accelerated next iterate, `#V x 3` each.
+    image: Vec<[f64; 3]>,
+    next: Vec<[f64; 3]>,
+    /// Per-vertex energies, summed in vertex order (deterministic).
+    vertex_energies: Vec<f64>,
 }
 
 impl Arap {
     /// A method with the given parameters; call [`DeformationMethod::precompute`] next.
     pub fn new(params: ArapParams) -> Result<Self, MethodError> {
-        if params.max_iterations == 0 || !(params.tolerance >= 0.0) {
+        if params.max_iterations == 0
+            || !(params.tolerance >= 0.0)
+            || params.anderson_depth > crate::linalg::anderson::MAX_DEPTH
+        {
             return Err(MethodError::Parameters {
                 method: "arap",
-                message: "max_iterations must be >= 1 and tolerance >= 0".into(),
+                message: "max_iterations must be >= 1, tolerance >= 0 and anderson_depth <= 16".into(),
             });
         }
         Ok(Self {
@@ -115,6 +154,9 @@ impl Arap {
             singular_frames: Vec::new(),
             rhs_rows: Vec::new(),
             rhs: Mat::zeros(0, 3),
+            image: Vec::new(),
+            next: Vec::new(),
+            vertex_energies: Vec::new(),
         })
     }
 
@@ -142,6 +184,32 @@ impl Arap {
                 *r = closest_rotation_warm(&cov, frame);
             },
         );
+    }
+
+    /// SA07 eq 3 at `current` with `rotations`: `sum_i sum_j w_ij |(x_i - x_j) - R_i (p_i - p_j)|^2`,
+    /// per vertex into `per_vertex` (in parallel), summed in vertex order.
+    fn energy(spokes: &Spokes, current: &[[f64; 3]], rotations: &[Mat3], per_vertex: &mut [f64]) -> f64 {
+        per_vertex.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, out)| {
+            let (xi, r) = (current[i], &rotations[i]);
+            let mut sum = 0.0;
+            for s in spokes.offsets[i]..spokes.offsets[i + 1] {
+                let xj = current[spokes.neighbors[s] as usize];
+                let e = spokes.rest_edges[s];
+                for a in 0..3 {
+                    let d = (xi[a] - xj[a]) - (r[a][0] * e[0] + r[a][1] * e[1] + r[a][2] * e[2]);
+                    sum += spokes.weights[s] * d * d;
+                }
+            }
+            *out = sum;
+        });
+        per_vertex.iter().sum()
+    }
+
+    /// The energy of the current iterate after a local step on it.
+    pub fn current_energy(&self) -> Option<f64> {
+        let spokes = self.spokes.as_ref()?;
+        let mut per_vertex = vec![0.0; self.current.len()];
+        Some(Self::energy(spokes, &self.current, &self.rotations, &mut per_vertex))
     }
 
     /// Global-step right-hand side, `#V x 3`: constrained rows hold their targets; free rows hold
@@ -231,6 +299,9 @@ impl DeformationMethod for Arap {
         self.singular_frames = self.rotations.clone();
         self.rhs_rows = vec![[0.0; 3]; n];
         self.rhs = Mat::zeros(n, 3);
+        self.image = vec![[0.0; 3]; n];
+        self.next = vec![[0.0; 3]; n];
+        self.vertex_energies = vec![0.0; n];
         self.handles = None;
         Ok(())
     }
@@ -270,10 +341,30 @@ impl DeformationMethod for Arap {
             self.current[v as usize] = *t;
         }
         let region_of = handles.region_of();
+        let accelerated = self.params.acceleration == ArapAcceleration::Anderson && self.params.anderson_depth > 0;
+        let mut anderson = AndersonAcceleration::new(
+            if accelerated { self.params.anderson_depth } else { 0 },
+            if accelerated { 3 * self.current.len() } else { 0 },
+        );
+        let mut previous_energy = f64::INFINITY;
+        let mut has_image = false;
         let mut summary = SolveSummary { iterations: 0, converged: false, final_step: f64::INFINITY };
         for iteration in 0..self.params.max_iterations {
             let start = Instant::now();
             Self::local_step(spokes, &self.current, &mut self.rotations, &mut self.singular_frames);
+            if accelerated {
+                // Peng et al.'s safeguard: an extrapolated iterate must not raise the energy.
+                let energy = Self::energy(spokes, &self.current, &self.rotations, &mut self.vertex_energies);
+                let energy = if energy > previous_energy && has_image {
+                    self.current.copy_from_slice(&self.image);
+                    anderson.reset();
+                    Self::local_step(spokes, &self.current, &mut self.rotations, &mut self.singular_frames);
+                    Self::energy(spokes, &self.current, &self.rotations, &mut self.vertex_energies)
+                } else {
+                    energy
+                };
+                previous_energy = energy;
+            }
             Self::assemble_rhs(
                 spokes,
                 &self.rotations,
@@ -283,20 +374,31 @@ impl DeformationMethod for Arap {
                 &mut self.rhs,
             );
             cholesky.solve_in_place(self.rhs.as_mut());
-            let (done, stop) = finish_iteration(
-                "arap",
-                iteration,
-                start,
-                &mut self.current,
-                self.rhs.as_ref(),
-                self.bbox_diagonal,
-                self.params.tolerance,
-                observer,
-            )?;
+            // G(X) into `image`: checked, and the plain step |G(X) - X| judged.
+            let step = {
+                let mut image = std::mem::take(&mut self.image);
+                image.copy_from_slice(&self.current);
+                let step = move_to("arap", iteration, &mut image, self.rhs.as_ref())?;
+                self.image = image;
+                step / self.bbox_diagonal
+            };
+            has_image = true;
+            if accelerated && step >= self.params.tolerance {
+                anderson.next(self.current.as_flattened(), self.image.as_flattened(), self.next.as_flattened_mut());
+                std::mem::swap(&mut self.current, &mut self.next);
+            } else {
+                self.current.copy_from_slice(&self.image);
+            }
+            let (done, stop) =
+                report_iteration(iteration, start, step, &self.current, self.params.tolerance, observer);
             summary = done;
             if stop {
                 break;
             }
+        }
+        if accelerated && !summary.converged && has_image {
+            // Stopped at the cap or by the observer: return the last global solution.
+            self.current.copy_from_slice(&self.image);
         }
         Ok(summary)
     }

@@ -36,7 +36,7 @@
 //!   step is handled like the first.
 //! - Acceleration. Algorithm 1 converges linearly and slowly: on the survey cactus the largest step
 //!   is still 1e-3 of the diagonal after 50 plain outer iterations (E_phi 0.49 deg, 0.43 after
-//!   300). The outer iteration is therefore Anderson-accelerated ([`anderson`], depth 5 by default;
+//!   300). The outer iteration is therefore Anderson-accelerated ([`crate::linalg::anderson`], depth 5 by default;
 //!   `anderson_depth = 0` is the plain iteration). It does not change the fixed points, and the
 //!   convergence test uses the fixed-point residual `|T(x) - x|`, which is the plain step.
 //! - Step one's inner loop rarely meets `normal_tolerance` within `normal_iterations`: the smooth
@@ -46,7 +46,6 @@
 //!   at 0.44 after 50 outer iterations, with slower outer convergence the more inner iterations;
 //!   20 is the paper's upper figure and the default.
 
-pub mod anderson;
 pub mod gauss_map;
 pub mod optimal_rigidity;
 pub mod scale_aware_equations;
@@ -61,7 +60,7 @@ use meshes::geometry::{face_areas, face_normals_into};
 use meshes::{Topology, TriMesh};
 use serde::Deserialize;
 
-pub use anderson::AndersonAcceleration;
+pub use crate::linalg::anderson::{self, AndersonAcceleration};
 pub use gauss_map::{NormalPyramids, NormalUpdate};
 pub use optimal_rigidity::{rescaled_triangles, Stitching};
 pub use scale_aware_equations::ScaleAwareEquations;
