@@ -171,8 +171,11 @@ impl ArapCase {
     /// Our `arap` after exactly `iterations` iterations (no early exit), from the rest shape.
     fn our_arap(&self, iterations: usize) -> Vec<[f64; 3]> {
         // libigl's arap uses the mesh's cotangent weights.
-        let params: toml::Table =
-            format!("max_iterations = {iterations}\ntolerance = 0.0\nweights = \"cotan\"").parse().unwrap();
+        let params: toml::Table = format!(
+            "max_iterations = {iterations}\ntolerance = 0.0\nweights = \"cotan\"\nacceleration = \"none\""
+        )
+        .parse()
+        .unwrap();
         let mut arap = methods::registry::create("arap", &params).unwrap();
         arap.precompute(&self.mesh).unwrap();
         arap.bind_handles(&self.handles).unwrap();

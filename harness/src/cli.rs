@@ -8,10 +8,11 @@ use std::process::ExitCode;
 use crate::case::CaseResult;
 use crate::metrics::METRICS;
 use crate::regression::{BaselineKind, GateOutcome};
+use crate::report::{html, plots, render};
 use crate::scenario::load_specs;
 use crate::shard::Shard;
 use crate::suite::{self, SuiteOptions, SURVEY_DIR_ENV};
-use crate::{html, peers, plots, regression, render, report};
+use crate::{peers, regression, report};
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
 

@@ -2,8 +2,9 @@
 //! Algorithm 1, as Peng et al. 2018 use it for local/global geometry solvers. It changes the path,
 //! not the fixed points: a converged `x` has `T(x) = x` either way.
 //!
-//! Safeguard: when the residual `|T(x) - x|` grows, the history is dropped and the plain step
-//! `x <- T(x)` is taken (Algorithm 1 has no monotone energy to test instead).
+//! Safeguard (on by default; [`AndersonAcceleration::with_residual_growth_limit`] for callers with
+//! an energy to test, as `arap`): when the residual `|T(x) - x|` grows, the history is dropped and
+//! the plain step `x <- T(x)` is taken (scale_aware's Algorithm 1 has no monotone energy).
 
 /// The last `depth` differences of images `Delta g` and residuals `Delta f`, in fixed storage.
 pub struct AndersonAcceleration {
@@ -19,6 +20,8 @@ pub struct AndersonAcceleration {
     delta_f: Vec<Vec<f64>>,
     start: usize,
     len: usize,
+    /// The history is dropped when the residual grows by more than this factor in one step.
+    residual_growth_limit: f64,
 }
 
 impl AndersonAcceleration {
@@ -36,7 +39,16 @@ impl AndersonAcceleration {
             delta_f: vec![vec![0.0; dimension]; depth],
             start: 0,
             len: 0,
+            residual_growth_limit: 1.0,
         }
+    }
+
+    /// The same acceleration with the history dropped only when the residual grows by more than
+    /// `limit` (>= 1) in one step: for a caller that also guards the iteration itself (Peng et al.
+    /// 2018's energy test, `arap`), where a residual that rises a little is normal.
+    pub fn with_residual_growth_limit(mut self, limit: f64) -> Self {
+        self.residual_growth_limit = limit.max(1.0);
+        self
     }
 
     /// Forget the history (the next step is a plain one).
@@ -58,7 +70,7 @@ impl AndersonAcceleration {
             *r = gi - xi;
         }
         let norm = self.residual.iter().map(|v| v * v).sum::<f64>().sqrt();
-        if norm > self.previous_residual_norm {
+        if norm > self.residual_growth_limit * self.previous_residual_norm {
             self.reset();
         }
         if self.has_previous {

@@ -48,7 +48,7 @@ fn method_color(method: &str) -> RGBColor {
 /// Write every plot of `results` under `dir/plots/`; returns the paths written relative to `dir`
 /// (PNG and SVG of each plot).
 pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, HarnessError> {
-    crate::fonts::register_sans_serif()?;
+    crate::report::fonts::register_sans_serif()?;
     let plot_dir = dir.join("plots");
     std::fs::create_dir_all(&plot_dir).map_err(|error| HarnessError::Io { path: plot_dir.clone(), error })?;
     let mut written = Vec::new();

@@ -1,5 +1,5 @@
 //! Text on an [`RgbImage`] through plotters (font family `sans-serif`, registered by
-//! [`crate::fonts::register_sans_serif`]), placed by baseline, with subscripts for `E_theta`, and
+//! [`crate::report::fonts::register_sans_serif`]), placed by baseline, with subscripts for `E_theta`, and
 //! set glyph by glyph from the font's metrics ([`GlyphMetrics`]) where it has them.
 
 use std::sync::OnceLock;
@@ -88,7 +88,9 @@ fn font(size: f64) -> FontDesc<'static> {
 /// The figure font's metrics, read once; `None` if the font file lacks what [`GlyphMetrics`] reads.
 fn metrics() -> Option<&'static GlyphMetrics> {
     static METRICS: OnceLock<Option<GlyphMetrics>> = OnceLock::new();
-    METRICS.get_or_init(|| crate::fonts::register_sans_serif().ok().and_then(GlyphMetrics::load)).as_ref()
+    METRICS
+        .get_or_init(|| crate::report::fonts::register_sans_serif().ok().and_then(GlyphMetrics::load))
+        .as_ref()
 }
 
 /// How a span is set: each glyph's text with the offset of its ink from the span's start (pen
@@ -174,7 +176,7 @@ mod tests {
 
     #[test]
     fn text_is_drawn_above_its_baseline_where_it_is_aligned() {
-        crate::fonts::register_sans_serif().unwrap();
+        crate::report::fonts::register_sans_serif().unwrap();
         let mut image = RgbImage::filled(200, 60, [255; 3]);
         let label = Label::rich(
             &[("E", false), ("θ", true), (" 1.00°", false)],

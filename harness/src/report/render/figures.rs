@@ -72,14 +72,14 @@ const FIGURES: &str = "figures";
 /// method names are used in file names with characters other than ASCII letters, digits, `-`, `_`
 /// and `.` replaced by `_`. Each file is written atomically.
 ///
-/// Errors: no font for the labels ([`crate::fonts::register_sans_serif`]), or a file that cannot be
+/// Errors: no font for the labels ([`crate::report::fonts::register_sans_serif`]), or a file that cannot be
 /// encoded or written (the error names it).
 pub fn write_figures(
     dir: &Path,
     results: &[CaseResult],
     scenarios: &[LoadedScenario],
 ) -> Result<Vec<PathBuf>, HarnessError> {
-    crate::fonts::register_sans_serif()?;
+    crate::report::fonts::register_sans_serif()?;
     let columns = method_columns(results);
     let rows: Vec<Row> = scenarios
         .iter()
@@ -745,7 +745,7 @@ mod tests {
 
     #[test]
     fn notes_wrap_at_spaces_within_the_width() {
-        crate::fonts::register_sans_serif().unwrap();
+        crate::report::fonts::register_sans_serif().unwrap();
         let text = "one two three four five six seven eight nine ten";
         let lines = wrap(text, DETAIL_PX, 120.0).unwrap();
         assert!(lines.len() > 2, "{lines:?}");

@@ -113,7 +113,7 @@ mod tests {
 
     #[test]
     fn the_registered_font_maps_characters_and_has_bearings() {
-        let path = crate::fonts::register_sans_serif().unwrap();
+        let path = crate::report::fonts::register_sans_serif().unwrap();
         let m = GlyphMetrics::load(path).expect("the figure font has hmtx and a format-4 cmap");
         for c in ['a', 'i', 'n', 'E', '0', '\u{3b8}', '\u{3c6}', '\u{b0}', '\u{2265}', ' '] {
             assert!(m.glyph(c).is_some(), "{c:?}");

@@ -1,0 +1,11 @@
+//! Everything the harness writes for people to read: the result tables and meshes ([`tables`]),
+//! the plots ([`plots`]), the pictures ([`render`]), the HTML page ([`html`]) and the font they
+//! share ([`fonts`]). Each writer renders in memory first and writes its files atomically.
+
+pub mod fonts;
+pub mod html;
+pub mod plots;
+pub mod render;
+pub mod tables;
+
+pub use tables::*;
