@@ -34,7 +34,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let model = &independent.model;
     let diagonal = rest.bbox_diagonal();
     for (name, shape) in [("rest", &rest), ("target", &target)] {
-        let fit = model.least_squares_fit(shape.positions());
+        let fit =
+            model.least_squares_fit(shape.positions()).ok_or("the fit's normal equations are singular")?;
         let fitted = model.positions(fit.as_ref());
         let d: Vec<f64> = fitted
             .iter()

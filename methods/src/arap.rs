@@ -31,7 +31,7 @@
 //!
 //! Acceleration (`acceleration`, default `anderson`): the local/global iteration is the fixed-point
 //! map `X <- G(X)` (local step on `X`, then the global solve), and Anderson acceleration (Peng, Deng,
-//! Zhang, Geng, Qin & Liu 2018, Algorithm 2, depth `anderson_depth`) extrapolates from the last
+//! Zhang, Geng, Qin & Liu 2018; depth `anderson_depth`) extrapolates from the last
 //! steps. Their safeguard keeps the energy monotone: when the accelerated iterate's energy (with its
 //! own local-step rotations) exceeds the previous iterate's, it is replaced by the plain image
 //! `G(X_prev)` and the history is dropped. Convergence is judged on the plain step `|G(X) - X|`
@@ -211,13 +211,6 @@ impl Arap {
         per_vertex.iter().sum()
     }
 
-    /// The energy of the current iterate after a local step on it.
-    pub fn current_energy(&self) -> Option<f64> {
-        let spokes = self.spokes.as_ref()?;
-        let mut per_vertex = vec![0.0; self.current.len()];
-        Some(Self::energy(spokes, &self.current, &self.rotations, &mut per_vertex))
-    }
-
     /// Global-step right-hand side, `#V x 3`: constrained rows hold their targets; free rows hold
     /// `b_i + sum_{j constrained} w_ij x_j` (the constrained columns moved to the right).
     fn assemble_rhs(
@@ -383,13 +376,8 @@ impl DeformationMethod for Arap {
             );
             cholesky.solve_in_place(self.rhs.as_mut());
             // G(X) into `image`: checked, and the plain step |G(X) - X| judged.
-            let step = {
-                let mut image = std::mem::take(&mut self.image);
-                image.copy_from_slice(&self.current);
-                let step = move_to("arap", iteration, &mut image, self.rhs.as_ref())?;
-                self.image = image;
-                step / self.bbox_diagonal
-            };
+            self.image.copy_from_slice(&self.current);
+            let step = move_to("arap", iteration, &mut self.image, self.rhs.as_ref())? / self.bbox_diagonal;
             has_image = true;
             if accelerated && step >= self.params.tolerance {
                 anderson.next(

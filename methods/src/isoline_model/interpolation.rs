@@ -368,8 +368,9 @@ impl IsolineModel {
 
     /// The transforms `R` (`4N x 3`) whose `W_x R` is nearest to `target` (`#V x 3`) in least
     /// squares over every vertex: how well the reduced space can represent a shape at all. A tiny
-    /// ridge (1e-12 of the largest diagonal entry) keeps transforms no vertex sees determined.
-    pub fn least_squares_fit(&self, target: &[[f64; 3]]) -> Mat<f64> {
+    /// ridge (1e-12 of the largest diagonal entry) keeps transforms no vertex sees determined;
+    /// `None` if the normal equations still cannot be factored.
+    pub fn least_squares_fit(&self, target: &[[f64; 3]]) -> Option<Mat<f64>> {
         let size = 4 * self.n_isolines();
         let mut normal = Mat::<f64>::zeros(size, size);
         let mut rhs = Mat::<f64>::zeros(size, 3);
@@ -388,10 +389,8 @@ impl IsolineModel {
         for i in 0..size {
             normal[(i, i)] += ridge;
         }
-        normal
-            .llt(faer::Side::Lower)
-            .map(|llt| faer::linalg::solvers::Solve::solve(&llt, &rhs))
-            .unwrap_or_else(|_| Mat::zeros(size, 3))
+        let llt = normal.llt(faer::Side::Lower).ok()?;
+        Some(faer::linalg::solvers::Solve::solve(&llt, &rhs))
     }
 
     /// `W_delta` row `k`: `(column, value)` pairs.
