@@ -42,6 +42,16 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
     .unwrap();
     assert_eq!(code, std::process::ExitCode::SUCCESS);
     let rows = csv_rows(&reports.path().join("results.csv"));
+    // Issue 18: lean outputs. The resolution sweeps write no meshes unless asked (`--every-mesh`),
+    // and the whole report stays under 50 MB.
+    assert!(rows.iter().any(|r| r["scenario"] == "bar-sweep-200k"));
+    let sweep_meshes = std::fs::read_dir(reports.path().join("meshes"))
+        .unwrap()
+        .filter(|e| e.as_ref().unwrap().file_name().to_string_lossy().contains("-sweep-"))
+        .count();
+    assert_eq!(sweep_meshes, 0, "sweep meshes written by default");
+    let bytes = support::directory_bytes(reports.path());
+    assert!(bytes < 50_000_000, "reports/ is {:.1} MB", bytes as f64 / 1e6);
     for scenario in ["bar", "cactus", "cylinder", "plane"] {
         for method in methods::registry::method_names() {
             let row = rows
@@ -77,11 +87,12 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
                 let v = num(row, key);
                 assert!(v.is_finite() && v >= 0.0, "{scenario}/{method}: {key} = {v}");
             }
-            let off = reports.path().join(format!("meshes/{scenario}-{method}.off"));
+            // GLB by default; OFF only with `--mesh-format off|both`.
             let glb = reports.path().join(format!("meshes/{scenario}-{method}.glb"));
-            let result = meshes::io::read_mesh(&off).unwrap();
+            let result = meshes::io::read_mesh(&glb).unwrap();
             assert_eq!(result.n_vertices(), row["vertices"].parse::<usize>().unwrap());
-            assert_eq!(meshes::io::read_mesh(&glb).unwrap().n_faces(), result.n_faces());
+            assert_eq!(result.n_faces(), row["faces"].parse::<usize>().unwrap());
+            assert!(!reports.path().join(format!("meshes/{scenario}-{method}.off")).exists());
         }
         let arap = rows.iter().find(|r| r["scenario"] == scenario && r["method"] == "arap").unwrap();
         assert_eq!(num(arap, "rms_to_arap_over_diag"), 0.0);
@@ -154,10 +165,13 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
     // Laplacian initialization (iteration 0) on the cactus.
     let convergence = csv_rows(&reports.path().join("convergence.csv"));
     for method in ["scale_aware", "scale_aware_ora"] {
-        let curve: Vec<_> =
+        let rows: Vec<_> =
             convergence.iter().filter(|r| r["scenario"] == "cactus" && r["method"] == method).collect();
-        assert!(curve.len() >= 3, "cactus/{method}: {} iterations in convergence.csv", curve.len());
-        assert!(curve.iter().all(|r| !r["e_theta_deg"].is_empty() && !r["e_phi_deg"].is_empty()));
+        // The angle errors are evaluated on the first ten iterations, then on a geometric grid.
+        let curve: Vec<_> = rows.iter().filter(|r| !r["e_theta_deg"].is_empty()).collect();
+        assert!(curve.len() >= 3, "cactus/{method}: {} iterations with E_theta", curve.len());
+        assert!(curve.len() < rows.len(), "cactus/{method}: {} iterations, all evaluated", rows.len());
+        assert!(curve.iter().all(|r| !r["e_phi_deg"].is_empty()));
         for key in ["e_theta_deg", "e_phi_deg"] {
             let (first, last) = (num(curve[0], key), num(curve[curve.len() - 1], key));
             assert!(
@@ -858,7 +872,7 @@ fn unreferenced_vertices_are_dropped_and_results_keep_the_input_order() {
     let configs = configs_with(&[("stray.toml".to_string(), text)]);
     let reports = root.path().join("reports");
     assert_eq!(all_with(configs.path(), &reports).unwrap(), std::process::ExitCode::SUCCESS);
-    let result = meshes::io::read_mesh(reports.join("meshes/stray-arap.off")).unwrap();
+    let result = meshes::io::read_mesh(reports.join("meshes/stray-arap.glb")).unwrap();
     assert_eq!(result.n_vertices(), p.len(), "written in the input's vertex order, the stray included");
     assert_eq!(result.positions()[0], [5.0, 5.0, 5.0], "the stray stays where it was");
     assert_eq!(result.triangles()[0], bar.triangles()[0].map(|v| v + 1));

@@ -7,12 +7,13 @@ use std::process::ExitCode;
 
 use crate::case::CaseResult;
 use crate::metrics::METRICS;
-use crate::regression::{BaselineKind, GateOutcome};
-use crate::report::{html, plots, render};
+use crate::peers;
+use crate::pipeline::{self, GateRequest, Outcome, PublishOptions};
+use crate::regression::{self, GateOutcome};
+use crate::report::{MeshFormat, MeshOutput};
 use crate::scenario::load_specs;
 use crate::shard::Shard;
 use crate::suite::{self, SuiteOptions, SURVEY_DIR_ENV};
-use crate::{peers, regression, report};
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
 
@@ -36,6 +37,8 @@ enum Command {
         #[command(flatten)]
         peers: Peers,
         #[command(flatten)]
+        meshes: Meshes,
+        #[command(flatten)]
         gate: Gate,
         /// Skip the regression check.
         #[arg(long)]
@@ -55,6 +58,8 @@ enum Command {
         #[command(flatten)]
         common: Common,
         #[command(flatten)]
+        meshes: Meshes,
+        #[command(flatten)]
         gate: Gate,
     },
     /// Run chosen methods on one scenario and print the results (writes reports/ like `all`).
@@ -69,6 +74,8 @@ enum Command {
         common: Common,
         #[command(flatten)]
         peers: Peers,
+        #[command(flatten)]
+        meshes: Meshes,
     },
     /// Compare reports/results.json with the baseline; exit non-zero naming every regression.
     Check {
@@ -126,15 +133,6 @@ struct Gate {
     baseline: Option<PathBuf>,
 }
 
-impl Gate {
-    /// The baseline `results` are compared with.
-    fn path(&self, results: &[CaseResult]) -> PathBuf {
-        self.baseline
-            .clone()
-            .unwrap_or_else(|| BaselineKind::of(results).default_path(&suite::workspace_root()))
-    }
-}
-
 #[derive(Args, Clone)]
 struct Common {
     /// Directory with the survey's .off/.sel/.def files [env: DEFORM_SURVEY_DIR]. Without it the
@@ -154,6 +152,23 @@ struct Common {
     /// Hide the progress bar.
     #[arg(long)]
     quiet: bool,
+}
+
+#[derive(Args, Clone)]
+struct Meshes {
+    /// Format of the result meshes in reports/meshes/.
+    #[arg(long, value_enum, default_value_t = MeshFormat::Glb)]
+    mesh_format: MeshFormat,
+    /// Also write the result meshes of scenarios that say `result_meshes = false` (the resolution
+    /// sweeps).
+    #[arg(long)]
+    every_mesh: bool,
+}
+
+impl Meshes {
+    fn output(&self) -> MeshOutput {
+        MeshOutput { format: self.mesh_format, every_scenario: self.every_mesh }
+    }
 }
 
 impl Common {
@@ -187,50 +202,49 @@ where
 {
     let cli = Cli::parse_from(args);
     match cli.command {
-        Command::All { common, peers, gate, no_check, shard } => {
+        Command::All { common, peers, meshes, gate, no_check, shard } => {
             let options = common.options(Vec::new(), Vec::new());
             if let Some(shard) = shard {
                 return run_shard(&options, shard);
             }
-            let gate = if no_check { Err("--no-check".to_string()) } else { standard_suite(&options, gate) };
+            let gate = if no_check {
+                GateRequest::Skip("--no-check".to_string())
+            } else {
+                GateRequest::for_suite(&options, gate.baseline)
+            };
+            let publish = PublishOptions { peer_python: peers.python()?, meshes: meshes.output() };
             let run = suite::run(&options).context("preparing the run")?;
-            publish(&options, run, peers.python()?, gate)
+            publish_and_print(&options, run, &publish, gate)
         }
-        Command::Merge { partials, common, gate } => {
+        Command::Merge { partials, common, meshes, gate } => {
             let options = common.options(Vec::new(), Vec::new());
             let run = suite::merge(&options, &partials).context("merging partial reports")?;
-            let gate = standard_suite(&options, gate);
-            publish(&options, run, None, gate)
+            let gate = GateRequest::for_suite(&options, gate.baseline);
+            let publish = PublishOptions { peer_python: None, meshes: meshes.output() };
+            publish_and_print(&options, run, &publish, gate)
         }
-        Command::Run { methods, scenario, common, peers } => {
+        Command::Run { methods, scenario, common, peers, meshes } => {
             let options = common.options(vec![scenario], methods);
+            let publish = PublishOptions { peer_python: peers.python()?, meshes: meshes.output() };
             let run = suite::run(&options).context("preparing the run")?;
-            publish(&options, run, peers.python()?, Err("`run` covers one scenario".to_string()))
+            publish_and_print(
+                &options,
+                run,
+                &publish,
+                GateRequest::Skip("`run` covers one scenario".to_string()),
+            )
         }
         Command::Check { common, gate } => {
             let dir = common.options(Vec::new(), Vec::new()).reports_dir;
-            let results = report::read_results(&dir.join("results.json"))?.cases;
-            let path = gate.path(&results);
-            if !path.is_file() {
-                anyhow::bail!("{}: no such baseline", path.display());
-            }
-            match regression::gate(&path, &results)? {
+            match pipeline::check(&dir, gate.baseline.as_deref())? {
                 GateOutcome::Checked { baseline, findings } => Ok(print_findings(&findings, &baseline)),
                 GateOutcome::NotChecked(reason) => anyhow::bail!("{reason}"),
             }
         }
         Command::Baseline { common, gate } => {
             let dir = common.options(Vec::new(), Vec::new()).reports_dir;
-            let results = report::read_results(&dir.join("results.json"))?.cases;
-            let baseline = regression::baseline_from(&results);
-            let path = gate.path(&results);
-            regression::write_baseline(&path, &baseline)?;
-            println!(
-                "baseline: {} cases from {} written to {}",
-                baseline.cases.len(),
-                dir.display(),
-                path.display()
-            );
+            let (path, cases) = pipeline::write_baseline(&dir, gate.baseline.as_deref())?;
+            println!("baseline: {cases} cases from {} written to {}", dir.display(), path.display());
             Ok(ExitCode::SUCCESS)
         }
         Command::List(common) => {
@@ -267,102 +281,68 @@ fn print_findings(findings: &[regression::Finding], baseline: &std::path::Path) 
     }
 }
 
-/// The gate of a run with `options`: the committed baselines cover the default configuration
-/// (`configs/` and its scenarios); any other run is compared only with a baseline named on purpose.
-fn standard_suite(options: &SuiteOptions, gate: Gate) -> Result<Gate, String> {
-    let default_configs = suite::workspace_root().join("configs");
-    let same = |a: &std::path::Path, b: &std::path::Path| {
-        a.canonicalize().ok().zip(b.canonicalize().ok()).is_some_and(|(a, b)| a == b)
-    };
-    if gate.baseline.is_some() {
-        Ok(gate)
-    } else if !same(&options.configs_dir, &default_configs) || options.scenarios_dir.is_some() {
-        Err(format!(
-            "the committed baselines cover the scenarios of {} (name one with --baseline)",
-            default_configs.display()
-        ))
-    } else {
-        Ok(gate)
-    }
-}
-
 /// Run part `shard` of the suite and write its partial report.
 fn run_shard(options: &SuiteOptions, shard: Shard) -> anyhow::Result<ExitCode> {
     let run = suite::run_shard(options, shard).context("preparing the run")?;
     for note in &run.notes {
         eprintln!("note: {note}");
     }
-    let dir = &options.reports_dir;
-    report::write_partial(dir, &run.results, &run.scenarios, &run.data_source, shard)
-        .context("writing the partial report")?;
+    let failed = pipeline::publish_partial(options, &run, shard).context("writing the partial report")?;
     print_table(&run.results);
     println!(
         "shard {shard}: {} scenario(s), {} case(s); partial report in {} (combine the N parts with `harness merge`)",
         run.scenarios.len(),
         run.results.len(),
-        dir.display()
+        options.reports_dir.display()
     );
-    if run.results.iter().any(|r| r.status.is_failed()) {
+    if failed > 0 {
         eprintln!("error: some case(s) failed (see the status column)");
         return Ok(ExitCode::from(EXIT_CASE_FAILED));
     }
     Ok(ExitCode::SUCCESS)
 }
 
-/// Check the results of `run` with open3d when `peer_python` is given, write every report, and
-/// compare with the baseline `gate` names (or say why not); print the table and pick the exit code.
-fn publish(
+/// Publish `run` ([`pipeline::publish`]), print its notes, table, phase times and gate findings,
+/// and pick the exit code: [`EXIT_CASE_FAILED`] over [`EXIT_REGRESSION`] over success.
+fn publish_and_print(
     options: &SuiteOptions,
     mut run: suite::SuiteRun,
-    peer_python: Option<PathBuf>,
-    gate: Result<Gate, String>,
+    publish: &PublishOptions,
+    gate: GateRequest,
 ) -> anyhow::Result<ExitCode> {
     for note in &run.notes {
         eprintln!("note: {note}");
     }
-    if let Some(python) = peer_python {
-        let answers = peers::self_intersections(&python, &run.results, &run.scenarios)
-            .context("self-intersection check (open3d)")?;
-        for (r, answer) in run.results.iter_mut().zip(answers) {
-            r.self_intersecting = answer;
-        }
-    }
-    let dir = &options.reports_dir;
-    report::write_reports(dir, &run.results, &run.scenarios, &run.data_source).context("writing reports")?;
-    let mut images = plots::write_plots(dir, &run.results).context("writing plots")?;
-    images.extend(render::write_figures(dir, &run.results, &run.scenarios).context("writing figures")?);
-
-    let outcome = match gate {
-        Ok(gate) => regression::gate(&gate.path(&run.results), &run.results)?,
-        Err(reason) => GateOutcome::NotChecked(reason),
-    };
-    let table1 = report::render_table1(&run.results);
-    html::write_index(
-        dir,
-        &html::render_index(&run.results, &run.data_source, &images, &table1, &outcome, &run.notes),
-    )
-    .context("writing index.html")?;
-
+    let outcome = pipeline::publish(options, &mut run, publish, gate).context("writing reports")?;
     println!("data: {}", run.data_source);
     print_table(&run.results);
+    print_phases(&outcome);
     println!("reports: {} (open index.html)", options.reports_dir.display());
-    let gate_code = match &outcome {
+    let gate_code = match &outcome.gate {
         GateOutcome::Checked { baseline, findings } => print_findings(findings, baseline),
         GateOutcome::NotChecked(reason) => {
             println!("regression check skipped: {reason}");
             ExitCode::SUCCESS
         }
     };
-    let suspect = run.results.iter().filter(|r| r.status.is_suspect()).count();
-    if suspect > 0 {
-        println!("{suspect} case(s) suspect (see the status column and the reasons there)");
+    if outcome.suspect > 0 {
+        println!("{} case(s) suspect (see the status column and the reasons there)", outcome.suspect);
     }
-    let failed = run.results.iter().filter(|r| r.status.is_failed()).count();
-    if failed > 0 {
-        eprintln!("error: {failed} case(s) failed (see the status column)");
+    if outcome.failed > 0 {
+        eprintln!("error: {} case(s) failed (see the status column)", outcome.failed);
         return Ok(ExitCode::from(EXIT_CASE_FAILED));
     }
     Ok(gate_code)
+}
+
+/// Where the run's wall time went, one line per phase.
+fn print_phases(outcome: &Outcome) {
+    let total: f64 = outcome.phases.iter().map(|(_, s)| s).sum();
+    println!("time by phase (wall seconds):");
+    for (phase, seconds) in &outcome.phases {
+        println!("  {:<38} {seconds:>8.2}", phase.label());
+    }
+    println!("  {:<38} {total:>8.2}", "total");
 }
 
 /// The results table on stdout: one row per case, the timings, every metric of the table, the status.

@@ -7,6 +7,7 @@ pub mod config;
 pub mod error;
 pub mod metrics;
 pub mod peers;
+pub mod pipeline;
 pub mod regression;
 pub mod report;
 pub mod scenario;

@@ -272,17 +272,48 @@ pub fn render_convergence(results: &[CaseResult]) -> Result<Vec<u8>, HarnessErro
     w.into_inner().map_err(|e| HarnessError::Report(format!("CSV: {e}")))
 }
 
+/// The file format of the result meshes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum MeshFormat {
+    /// Binary glTF (`.glb`, f32 positions): small, opens in any viewer.
+    #[default]
+    Glb,
+    /// OFF (`.off`, shortest round-trip decimals): exact, what the survey tools and libigl read.
+    Off,
+    /// Both.
+    Both,
+}
+
+impl MeshFormat {
+    fn writes_glb(self) -> bool {
+        matches!(self, MeshFormat::Glb | MeshFormat::Both)
+    }
+    fn writes_off(self) -> bool {
+        matches!(self, MeshFormat::Off | MeshFormat::Both)
+    }
+}
+
+/// Which result meshes a report writes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MeshOutput {
+    pub format: MeshFormat,
+    /// Also the scenarios with `result_meshes = false` (the resolution sweeps: 200K-vertex bars
+    /// nobody opens, most of the bytes of a report).
+    pub every_scenario: bool,
+}
+
 /// Write `results.csv`, `results.json`, `convergence.csv`, `handle_updates.csv`, `table1.md` and
-/// `meshes/<scenario>-<method>.{off,glb}` under `dir`.
+/// the result meshes `meshes/<scenario>-<method>.{glb,off}` that `meshes` asks for under `dir`.
 pub fn write_reports(
     dir: &Path,
     results: &[CaseResult],
     scenarios: &[LoadedScenario],
     data_source: &str,
+    meshes: &MeshOutput,
 ) -> Result<(), HarnessError> {
     let csv = render_csv(results)?;
     let json = render_json(results, data_source, None)?;
-    write_meshes(dir, results, scenarios)?;
+    write_meshes(dir, results, scenarios, meshes)?;
     write_bytes(&dir.join("convergence.csv"), &render_convergence(results)?)?;
     write_bytes(&dir.join("handle_updates.csv"), &render_handle_updates(results)?)?;
     write_bytes(&dir.join("table1.md"), render_table1(results).as_bytes())?;
@@ -291,7 +322,8 @@ pub fn write_reports(
     Ok(())
 }
 
-/// `results.json` with `shard` and the result meshes under `dir`: what `merge` needs of one part.
+/// `results.json` with `shard` and every result mesh as OFF under `dir`: what `merge` needs of one
+/// part (OFF because merge measures the shapes again, and GLB's f32 positions would move them).
 pub fn write_partial(
     dir: &Path,
     results: &[CaseResult],
@@ -300,15 +332,18 @@ pub fn write_partial(
     shard: Shard,
 ) -> Result<(), HarnessError> {
     let json = render_json(results, data_source, Some(shard))?;
-    write_meshes(dir, results, scenarios)?;
+    let every_mesh = MeshOutput { format: MeshFormat::Off, every_scenario: true };
+    write_meshes(dir, results, scenarios, &every_mesh)?;
     write_bytes(&dir.join("results.json"), &json)
 }
 
-/// `meshes/<scenario>-<method>.{off,glb}` of every case with a result, in the input's vertex order.
+/// `meshes/<scenario>-<method>.{glb,off}` of every case with a result that `output` covers, in the
+/// input's vertex order.
 fn write_meshes(
     dir: &Path,
     results: &[CaseResult],
     scenarios: &[LoadedScenario],
+    output: &MeshOutput,
 ) -> Result<(), HarnessError> {
     let mesh_dir = dir.join("meshes");
     std::fs::create_dir_all(&mesh_dir).map_err(|error| HarnessError::Io { path: mesh_dir.clone(), error })?;
@@ -318,11 +353,18 @@ fn write_meshes(
         else {
             continue;
         };
+        if !(output.every_scenario || scenario.spec.writes_result_meshes()) {
+            continue;
+        }
         // In the input file's vertex order, so per-vertex data of the input still applies.
         let mesh = scenario.in_input_order(positions)?;
         let stem = format!("{}-{}", r.scenario, r.method);
-        meshes::io::write_off(mesh_dir.join(format!("{stem}.off")), &mesh)?;
-        meshes::io::write_glb(mesh_dir.join(format!("{stem}.glb")), &mesh, None)?;
+        if output.format.writes_off() {
+            meshes::io::write_off(mesh_dir.join(format!("{stem}.off")), &mesh)?;
+        }
+        if output.format.writes_glb() {
+            meshes::io::write_glb(mesh_dir.join(format!("{stem}.glb")), &mesh, None)?;
+        }
     }
     Ok(())
 }

@@ -92,6 +92,10 @@ pub struct ScenarioSpec {
     /// Methods to run (default: all registered).
     #[serde(default)]
     pub methods: Option<Vec<String>>,
+    /// Whether reports write this scenario's result meshes (default `true`; the resolution sweeps
+    /// say `false`, and `--every-mesh` writes them anyway).
+    #[serde(default)]
+    pub result_meshes: Option<bool>,
     /// Edit steps (default: the first edit alone, the survey's or the `[[regions]]`).
     #[serde(default)]
     pub steps: Vec<StepSpec>,
@@ -362,6 +366,11 @@ impl SelectionFiles for InputFiles {
 }
 
 impl ScenarioSpec {
+    /// Whether reports write the result meshes of this scenario by default (`result_meshes`).
+    pub fn writes_result_meshes(&self) -> bool {
+        self.result_meshes.unwrap_or(true)
+    }
+
     /// Methods to run on this scenario, in registry order.
     pub fn method_names(&self) -> Vec<&'static str> {
         let all = methods::registry::method_names();

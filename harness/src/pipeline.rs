@@ -1,0 +1,225 @@
+//! What a run makes of its cases once they have run: the peer checks, every report, the plots and
+//! figures, the regression gate and the HTML index, as one function ([`publish`]) returning an
+//! [`Outcome`]. The CLI only parses arguments, prints the outcome and maps it to an exit code.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use crate::case::CaseResult;
+use crate::error::HarnessError;
+use crate::regression::{self, BaselineKind, GateOutcome};
+use crate::report::{self, html, plots, render, MeshOutput};
+use crate::suite::{self, SuiteOptions, SuiteRun};
+use crate::{peers, shard::Shard};
+
+/// Which baseline a run is compared with.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GateRequest {
+    /// The baseline at this path, or (`None`) the committed one of the run's data source
+    /// ([`BaselineKind::default_path`]).
+    Compare(Option<PathBuf>),
+    /// No comparison, and why.
+    Skip(String),
+}
+
+impl GateRequest {
+    /// The gate of a suite run with `options` and an optional `--baseline`: the committed baselines
+    /// cover the default configuration (the workspace's `configs/` and its scenarios); any other
+    /// run is compared only with a baseline named on purpose.
+    pub fn for_suite(options: &SuiteOptions, baseline: Option<PathBuf>) -> GateRequest {
+        let default_configs = suite::workspace_root().join("configs");
+        let same = |a: &Path, b: &Path| {
+            a.canonicalize().ok().zip(b.canonicalize().ok()).is_some_and(|(a, b)| a == b)
+        };
+        if baseline.is_some() {
+            GateRequest::Compare(baseline)
+        } else if !same(&options.configs_dir, &default_configs) || options.scenarios_dir.is_some() {
+            GateRequest::Skip(format!(
+                "the committed baselines cover the scenarios of {} (name one with --baseline)",
+                default_configs.display()
+            ))
+        } else {
+            GateRequest::Compare(None)
+        }
+    }
+}
+
+/// The baseline file `results` are compared with: `baseline` if given, else the committed baseline
+/// of their data source.
+pub fn baseline_path(baseline: Option<&Path>, results: &[CaseResult]) -> PathBuf {
+    baseline
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| BaselineKind::of(results).default_path(&suite::workspace_root()))
+}
+
+/// The work of a run after its cases, in the order [`publish`] does it; each is timed as a phase of
+/// the run ([`Outcome::phases`]). The methods' own phases are timed per case, before any of these.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RunPhase {
+    /// The methods' precompute, bind and solve, summed over the cases.
+    Methods,
+    /// `E_theta` / `E_phi` of the iterates for the convergence curves ([`crate::case::records_quality`]).
+    TraceQuality,
+    /// The quality measures of the final shapes.
+    Evaluation,
+    /// open3d's self-intersection check (`--self-intersections`).
+    PeerChecks,
+    /// results.{json,csv}, convergence.csv, handle_updates.csv, table1.md and the result meshes.
+    Reports,
+    /// The plots (plots/*.svg, *.png).
+    Plots,
+    /// The rendered figures (figures/*.png).
+    Figures,
+    /// The regression gate and index.html.
+    GateAndIndex,
+}
+
+impl RunPhase {
+    /// Every phase, in run order.
+    pub const ALL: [RunPhase; 8] = [
+        RunPhase::Methods,
+        RunPhase::TraceQuality,
+        RunPhase::Evaluation,
+        RunPhase::PeerChecks,
+        RunPhase::Reports,
+        RunPhase::Plots,
+        RunPhase::Figures,
+        RunPhase::GateAndIndex,
+    ];
+
+    /// Label printed at the end of a run.
+    pub fn label(self) -> &'static str {
+        match self {
+            RunPhase::Methods => "methods (precompute + bind + solve)",
+            RunPhase::TraceQuality => "E_theta/E_phi of the iterates",
+            RunPhase::Evaluation => "quality of the results",
+            RunPhase::PeerChecks => "self-intersections (open3d)",
+            RunPhase::Reports => "reports and result meshes",
+            RunPhase::Plots => "plots",
+            RunPhase::Figures => "figures",
+            RunPhase::GateAndIndex => "regression gate and index.html",
+        }
+    }
+}
+
+/// How [`publish`] writes a run.
+#[derive(Clone, Debug, Default)]
+pub struct PublishOptions {
+    /// The cross-check Python with open3d, when the self-intersection check was asked for.
+    pub peer_python: Option<PathBuf>,
+    /// Which result meshes to write, in which format.
+    pub meshes: MeshOutput,
+}
+
+/// What a published run came to.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The regression gate's findings, or why it did not compare.
+    pub gate: GateOutcome,
+    /// Cases whose status is `suspect`.
+    pub suspect: usize,
+    /// Cases whose status is `failed`.
+    pub failed: usize,
+    /// Wall seconds of each phase of the run ([`RunPhase::ALL`] order; a phase that did not run
+    /// is 0).
+    pub phases: Vec<(RunPhase, f64)>,
+}
+
+/// Check the results of `run` with open3d when asked, write every report, the plots and figures
+/// under `options.reports_dir`, compare with the baseline `gate` asks for and write index.html.
+/// Errors: a report that cannot be written, an unreadable baseline, a failed peer check.
+pub fn publish(
+    options: &SuiteOptions,
+    run: &mut SuiteRun,
+    publish: &PublishOptions,
+    gate: GateRequest,
+) -> Result<Outcome, HarnessError> {
+    let mut phases: Vec<(RunPhase, f64)> = vec![
+        (RunPhase::Methods, run.results.iter().map(method_seconds).sum()),
+        (RunPhase::TraceQuality, run.results.iter().map(|r| r.overhead.trace_quality_s).sum()),
+        (RunPhase::Evaluation, run.results.iter().map(|r| r.overhead.evaluation_s).sum()),
+    ];
+    let mut timed = |phase: RunPhase, start: Instant| phases.push((phase, start.elapsed().as_secs_f64()));
+
+    let start = Instant::now();
+    if let Some(python) = &publish.peer_python {
+        let answers = peers::self_intersections(python, &run.results, &run.scenarios)?;
+        for (r, answer) in run.results.iter_mut().zip(answers) {
+            r.self_intersecting = answer;
+        }
+    }
+    timed(RunPhase::PeerChecks, start);
+
+    let dir = &options.reports_dir;
+    let start = Instant::now();
+    report::write_reports(dir, &run.results, &run.scenarios, &run.data_source, &publish.meshes)?;
+    timed(RunPhase::Reports, start);
+
+    let start = Instant::now();
+    let mut images = plots::write_plots(dir, &run.results)?;
+    timed(RunPhase::Plots, start);
+
+    let start = Instant::now();
+    images.extend(render::write_figures(dir, &run.results, &run.scenarios)?);
+    timed(RunPhase::Figures, start);
+
+    let start = Instant::now();
+    let outcome = match gate {
+        GateRequest::Compare(baseline) => {
+            regression::gate(&baseline_path(baseline.as_deref(), &run.results), &run.results)?
+        }
+        GateRequest::Skip(reason) => GateOutcome::NotChecked(reason),
+    };
+    let table1 = report::render_table1(&run.results);
+    html::write_index(
+        dir,
+        &html::render_index(&run.results, &run.data_source, &images, &table1, &outcome, &run.notes),
+    )?;
+    timed(RunPhase::GateAndIndex, start);
+
+    Ok(Outcome {
+        gate: outcome,
+        suspect: run.results.iter().filter(|r| r.status.is_suspect()).count(),
+        failed: run.results.iter().filter(|r| r.status.is_failed()).count(),
+        phases,
+    })
+}
+
+/// Write part `shard` of a run (`run` holds that part's cases): `results.json` and every result
+/// mesh (OFF, full precision), what `harness merge` needs. Returns the number of failed cases.
+pub fn publish_partial(options: &SuiteOptions, run: &SuiteRun, shard: Shard) -> Result<usize, HarnessError> {
+    report::write_partial(&options.reports_dir, &run.results, &run.scenarios, &run.data_source, shard)?;
+    Ok(run.results.iter().filter(|r| r.status.is_failed()).count())
+}
+
+/// Compare the `results.json` in `reports_dir` with the baseline (`baseline`, or the committed one of
+/// its data source). Errors: no results, no such baseline, or a baseline of other data.
+pub fn check(reports_dir: &Path, baseline: Option<&Path>) -> Result<GateOutcome, HarnessError> {
+    let results_path = reports_dir.join("results.json");
+    let results = report::read_results(&results_path)?.cases;
+    let path = baseline_path(baseline, &results);
+    if !path.is_file() {
+        return Err(HarnessError::Config { path, message: "no such baseline".into() });
+    }
+    match regression::gate(&path, &results)? {
+        GateOutcome::NotChecked(reason) => Err(HarnessError::Config { path: results_path, message: reason }),
+        checked => Ok(checked),
+    }
+}
+
+/// Rewrite the baseline (`baseline`, or the committed one of the data source) from the
+/// `results.json` in `reports_dir`; returns the path written and the number of cases.
+pub fn write_baseline(reports_dir: &Path, baseline: Option<&Path>) -> Result<(PathBuf, usize), HarnessError> {
+    let results = report::read_results(&reports_dir.join("results.json"))?.cases;
+    let new = regression::baseline_from(&results);
+    let path = baseline_path(baseline, &results);
+    regression::write_baseline(&path, &new)?;
+    Ok((path, new.cases.len()))
+}
+
+/// Seconds a case's method spent in its own phases (precompute, every bind and solve); 0 for a case
+/// that failed before any was timed.
+fn method_seconds(r: &CaseResult) -> f64 {
+    let bind: f64 = r.steps.iter().map(|s| s.bind_s).sum();
+    [r.precompute_s, bind, r.solve_s].into_iter().filter(|t| t.is_finite()).sum()
+}
