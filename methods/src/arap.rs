@@ -43,8 +43,6 @@
 //! by identity (same pattern, so the symbolic analysis is reused for any handle set); each iteration is
 //! one local step, one right-hand side assembly and one back-substitution of 3 columns.
 
-use std::time::Instant;
-
 use faer::sparse::SparseColMat;
 use faer::Mat;
 use meshes::TriMesh;
@@ -55,7 +53,9 @@ use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets, FREE};
 use crate::linalg::anderson::AndersonAcceleration;
 use crate::linalg::sparse_cholesky::SparseCholesky;
-use crate::method::{move_to, report_iteration, DeformationMethod, IterationObserver, SolveSummary};
+use crate::method::{
+    move_to, run_iterations, DeformationMethod, IterationObserver, Iterations, SolveSummary,
+};
 use crate::operators::{laplacian, LaplacianWeights};
 use crate::rotation_fit::{closest_rotation_warm, Mat3};
 
@@ -283,11 +283,7 @@ impl DeformationMethod for Arap {
             }
             offsets.push(neighbors.len());
         }
-        let stiffness = {
-            let mut k = laplacian;
-            k.val_mut().iter_mut().for_each(|v| *v = -*v);
-            k
-        };
+        let stiffness = crate::operators::stiffness(laplacian);
         self.cholesky = Some(SparseCholesky::analyze(stiffness.as_ref())?);
         self.stiffness = Some(stiffness);
         self.spokes = Some(Spokes { offsets, neighbors, weights, rest_edges });
@@ -349,18 +345,19 @@ impl DeformationMethod for Arap {
         .with_residual_growth_limit(RESIDUAL_GROWTH_LIMIT);
         let mut previous_energy = f64::INFINITY;
         let mut has_image = false;
-        let mut summary = SolveSummary { iterations: 0, converged: false, final_step: f64::INFINITY };
-        for iteration in 0..self.params.max_iterations {
-            let start = Instant::now();
-            Self::local_step(spokes, &self.current, &mut self.rotations, &mut self.singular_frames);
+        let (tolerance, diagonal) = (self.params.tolerance, self.bbox_diagonal);
+        let iterations = Iterations { first: 0, count: self.params.max_iterations, tolerance };
+        // The state is the iterate X; the closure holds the rest of the method's buffers.
+        let iterate = |current: &mut Vec<[f64; 3]>, iteration: usize| -> Result<f64, MethodError> {
+            Self::local_step(spokes, current, &mut self.rotations, &mut self.singular_frames);
             if accelerated {
                 // Peng et al.'s safeguard: an extrapolated iterate must not raise the energy.
-                let energy = Self::energy(spokes, &self.current, &self.rotations, &mut self.vertex_energies);
+                let energy = Self::energy(spokes, current, &self.rotations, &mut self.vertex_energies);
                 let energy = if energy > previous_energy && has_image {
-                    self.current.copy_from_slice(&self.image);
+                    current.copy_from_slice(&self.image);
                     anderson.reset();
-                    Self::local_step(spokes, &self.current, &mut self.rotations, &mut self.singular_frames);
-                    Self::energy(spokes, &self.current, &self.rotations, &mut self.vertex_energies)
+                    Self::local_step(spokes, current, &mut self.rotations, &mut self.singular_frames);
+                    Self::energy(spokes, current, &self.rotations, &mut self.vertex_energies)
                 } else {
                     energy
                 };
@@ -370,32 +367,28 @@ impl DeformationMethod for Arap {
                 spokes,
                 &self.rotations,
                 region_of,
-                &self.current,
+                current,
                 &mut self.rhs_rows,
                 &mut self.rhs,
             );
             cholesky.solve_in_place(self.rhs.as_mut());
             // G(X) into `image`: checked, and the plain step |G(X) - X| judged.
-            self.image.copy_from_slice(&self.current);
-            let step = move_to("arap", iteration, &mut self.image, self.rhs.as_ref())? / self.bbox_diagonal;
+            self.image.copy_from_slice(current);
+            let step = move_to("arap", iteration, &mut self.image, self.rhs.as_ref())? / diagonal;
             has_image = true;
-            if accelerated && step >= self.params.tolerance {
+            if accelerated && step >= tolerance {
                 anderson.next(
-                    self.current.as_flattened(),
+                    current.as_flattened(),
                     self.image.as_flattened(),
                     self.next.as_flattened_mut(),
                 );
-                std::mem::swap(&mut self.current, &mut self.next);
+                std::mem::swap(current, &mut self.next);
             } else {
-                self.current.copy_from_slice(&self.image);
+                current.copy_from_slice(&self.image);
             }
-            let (done, stop) =
-                report_iteration(iteration, start, step, &self.current, self.params.tolerance, observer);
-            summary = done;
-            if stop {
-                break;
-            }
-        }
+            Ok(step)
+        };
+        let summary = run_iterations(iterations, &mut self.current, iterate, |x| x.clone(), observer)?;
         if accelerated && !summary.converged && has_image {
             // Stopped at the cap or by the observer: return the last global solution.
             self.current.copy_from_slice(&self.image);

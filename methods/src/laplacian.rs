@@ -23,8 +23,6 @@
 //!   `omega^2 Phi^T Phi` (a diagonal, so the pattern and the symbolic factorization are reused) and
 //!   factors numerically.
 
-use std::time::Instant;
-
 use faer::sparse::linalg::matmul::{sparse_dense_matmul, sparse_sparse_matmul};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Accum, Mat, Par};
@@ -35,7 +33,9 @@ use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
 use crate::laplacian_coordinates::RotationInvariantCoordinates;
 use crate::linalg::sparse_cholesky::{add_to_diagonal, SparseCholesky};
-use crate::method::{finish_iteration, DeformationMethod, IterationObserver, SolveSummary};
+use crate::method::{
+    move_to, run_iterations, DeformationMethod, IterationObserver, Iterations, SolveSummary,
+};
 use crate::operators::{laplacian, LaplacianWeights};
 
 /// Parameters of [`LaplacianEditing`] (configs/methods.toml, section `[laplacian]`).
@@ -176,42 +176,29 @@ impl DeformationMethod for LaplacianEditing {
             return Err(MethodError::Phase { method: "laplacian", phase: "solve", missing: "bind_handles" });
         }
         let w2 = self.params.omega * self.params.omega;
-        let mut summary = SolveSummary { iterations: 0, converged: false, final_step: f64::INFINITY };
-        for iteration in 0..self.params.max_iterations {
-            let start = Instant::now();
-            self.update_delta();
-            let rest = self.rest.as_ref().expect("bound implies precomputed");
-            let handles = self.handles.as_ref().expect("checked above");
+        let iterations =
+            Iterations { first: 0, count: self.params.max_iterations, tolerance: self.params.tolerance };
+        let iterate = |m: &mut Self, iteration: usize| -> Result<f64, MethodError> {
+            m.update_delta();
+            let rest = m.rest.as_ref().expect("bound implies precomputed");
+            let handles = m.handles.as_ref().expect("checked above");
             sparse_dense_matmul(
-                self.rhs.as_mut(),
+                m.rhs.as_mut(),
                 Accum::Replace,
                 rest.laplacian.as_ref(),
-                self.delta.as_ref(),
+                m.delta.as_ref(),
                 1.0,
                 Par::Seq,
             );
             for (v, t) in handles.constrained().zip(targets.positions()) {
                 for a in 0..3 {
-                    self.rhs[(v as usize, a)] += w2 * t[a];
+                    m.rhs[(v as usize, a)] += w2 * t[a];
                 }
             }
-            self.cholesky.as_mut().expect("bound").solve_in_place(self.rhs.as_mut());
-            let (done, stop) = finish_iteration(
-                "laplacian",
-                iteration,
-                start,
-                &mut self.current,
-                self.rhs.as_ref(),
-                rest.bbox_diagonal,
-                self.params.tolerance,
-                observer,
-            )?;
-            summary = done;
-            if stop {
-                break;
-            }
-        }
-        Ok(summary)
+            m.cholesky.as_mut().expect("bound").solve_in_place(m.rhs.as_mut());
+            Ok(move_to("laplacian", iteration, &mut m.current, m.rhs.as_ref())? / rest.bbox_diagonal)
+        };
+        run_iterations(iterations, self, iterate, |m| m.current.clone(), observer)
     }
 
     fn positions(&self) -> Vec<[f64; 3]> {

@@ -93,23 +93,49 @@ pub fn max_displacement(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     a.iter().zip(b).map(|(p, q)| meshes::vector::norm(meshes::vector::sub(*p, *q))).fold(0.0, f64::max)
 }
 
-/// The end of one iteration of a full-space method: move `current` (`#V x 3`) to the new iterate
-/// `solution` (`#V x 3`, column per coordinate), check it, report the step (relative to `diagonal`)
-/// and the time since `start` to `observer`. Returns the summary so far and whether to stop
-/// (converged below `tolerance`, or the observer asked).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn finish_iteration(
-    method: &'static str,
-    iteration: usize,
-    start: std::time::Instant,
-    current: &mut [[f64; 3]],
-    solution: faer::MatRef<'_, f64>,
-    diagonal: f64,
-    tolerance: f64,
+/// The iterations of one solve: indices `first..first + count`, stopping early once a step falls
+/// below `tolerance` (relative to the rest bounding-box diagonal).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Iterations {
+    /// Index of the first iteration (`scale_aware` reports its initialization as iteration 0).
+    pub first: usize,
+    /// Most iterations to run (the method's `max_iterations`).
+    pub count: usize,
+    pub tolerance: f64,
+}
+
+/// The loop of every iterative solve, full-space and reduced: for each iteration of `iterations`,
+/// `iterate(state, iteration)` does the iteration's work on `state` (the `#V x 3` positions of a
+/// full-space method, the reduced coefficients of a reduced one, or the whole method) and returns
+/// its step (largest displacement over the rest diagonal). The driver times the work, reports it to
+/// `observer` with the current `#V x 3` shape on demand (`shape(state)`, reconstructed only when the
+/// observer asks), and stops when the step falls below the tolerance, when the observer asks, or
+/// after the last iteration. An error of `iterate` ends the solve.
+pub(crate) fn run_iterations<S: ?Sized>(
+    iterations: Iterations,
+    state: &mut S,
+    mut iterate: impl FnMut(&mut S, usize) -> Result<f64, MethodError>,
+    shape: impl Fn(&S) -> Vec<[f64; 3]>,
     observer: &mut dyn IterationObserver,
-) -> Result<(SolveSummary, bool), crate::MethodError> {
-    let step = move_to(method, iteration, current, solution)? / diagonal;
-    Ok(report_iteration(iteration, start, step, current, tolerance, observer))
+) -> Result<SolveSummary, MethodError> {
+    let mut summary =
+        SolveSummary { iterations: iterations.first, converged: false, final_step: f64::INFINITY };
+    for iteration in iterations.first..iterations.first + iterations.count {
+        let start = std::time::Instant::now();
+        let step = iterate(state, iteration)?;
+        let report = IterationReport { iteration, step, seconds: start.elapsed().as_secs_f64() };
+        summary = SolveSummary {
+            iterations: iteration + 1,
+            converged: step < iterations.tolerance,
+            final_step: step,
+        };
+        let state: &S = state;
+        let flow = observer.on_iteration(&report, &|| shape(state));
+        if summary.converged || flow.is_break() {
+            break;
+        }
+    }
+    Ok(summary)
 }
 
 /// Move `current` (`#V x 3`) to `solution` (`#V x 3`) after checking that it is finite; returns the
@@ -131,21 +157,4 @@ pub(crate) fn move_to(
         *x = new;
     }
     Ok(step2.sqrt())
-}
-
-/// Report iteration `iteration` with its (relative) `step` and the time since `start` to
-/// `observer`; returns the summary so far and whether to stop (`step < tolerance`, or the observer
-/// asked).
-pub(crate) fn report_iteration(
-    iteration: usize,
-    start: std::time::Instant,
-    step: f64,
-    current: &[[f64; 3]],
-    tolerance: f64,
-    observer: &mut dyn IterationObserver,
-) -> (SolveSummary, bool) {
-    let report = IterationReport { iteration, step, seconds: start.elapsed().as_secs_f64() };
-    let summary = SolveSummary { iterations: iteration + 1, converged: step < tolerance, final_step: step };
-    let flow = observer.on_iteration(&report, &|| current.to_vec());
-    (summary, summary.converged || flow == ControlFlow::Break(()))
 }

@@ -1,7 +1,7 @@
 //! Identities of the discrete operators, on procedural meshes.
 
 use meshes::shapes::{generate, ShapeKind};
-use methods::operators::{cotan_laplacian, lumped_mass, MassKind};
+use methods::operators::{cotan_laplacian, laplacian, lumped_mass, stiffness, LaplacianWeights, MassKind};
 
 fn dense_row_sums_and_asymmetry(l: &faer::sparse::SparseColMat<usize, f64>) -> (f64, f64) {
     let (sym, val) = l.parts();
@@ -43,6 +43,35 @@ fn laplacian_annihilates_constants_and_is_symmetric() {
                 }
             }
             assert!(q >= 0.0, "{kind:?}: x^T(-L)x = {q}");
+        }
+    }
+}
+
+#[test]
+fn stiffness_is_minus_the_laplacian_and_positive_semi_definite() {
+    let shape = generate(ShapeKind::Cactus, 2000).unwrap();
+    let (p, t) = (shape.mesh.positions(), shape.mesh.triangles());
+    for weights in [LaplacianWeights::Cotan, LaplacianWeights::Clamped, LaplacianWeights::IntrinsicDelaunay] {
+        let l = laplacian(weights, p, t).unwrap();
+        let k = stiffness(l.clone());
+        assert_eq!(k.parts().0.row_idx(), l.parts().0.row_idx(), "{weights:?}: same sparsity");
+        assert!(k.val().iter().zip(l.val()).all(|(a, b)| *a == -*b), "{weights:?}: K = -L");
+        let (sym, val) = k.parts();
+        // x^T K x on a deterministic non-smooth vector (a hash of the index), not only on coordinates.
+        let x: Vec<f64> = (0..sym.nrows()).map(|i| ((i * 2654435761) % 1000) as f64 / 1000.0 - 0.5).collect();
+        let mut q = 0.0;
+        for j in 0..sym.ncols() {
+            for idx in sym.col_range(j) {
+                let i = sym.row_idx()[idx];
+                q += x[i] * val[idx] * x[j];
+                if i == j {
+                    assert!(val[idx] >= 0.0, "{weights:?}: K_{i}{i} = {}", val[idx]);
+                }
+            }
+        }
+        // Intrinsic Delaunay weights are non-negative, so its K is PSD for every x.
+        if weights == LaplacianWeights::IntrinsicDelaunay {
+            assert!(q >= 0.0, "{weights:?}: x^T K x = {q}");
         }
     }
 }

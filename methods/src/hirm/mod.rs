@@ -86,10 +86,9 @@ pub use propagation_fields::{propagation_fields, select_fields, PropagationField
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
 use crate::isoline_model::{
-    add_constraint_rows_lower, checked_positions, constraint_rhs, finish_reduced_iteration, ReducedIteration,
-    RotationFit,
+    add_constraint_rows_lower, checked_positions, constraint_rhs, reduced_step, ReducedIteration, RotationFit,
 };
-use crate::method::{DeformationMethod, IterationObserver, SolveSummary};
+use crate::method::{run_iterations, DeformationMethod, IterationObserver, Iterations, SolveSummary};
 use crate::operators::{laplacian, lumped_mass_for, LaplacianWeights, MassKind};
 
 /// Parameters of [`Hirm`] (configs/methods.toml, section `[hirm]`).
@@ -423,34 +422,20 @@ impl DeformationMethod for Hirm {
         // omega^2 W^T Phi^T H of eq 27, once per solve.
         let constraints = constraint_rhs(model, &bound.handles, targets, self.params.omega);
         let mut probes = model.probe_positions(self.reduced.as_ref());
-        let mut summary = SolveSummary { iterations: 0, converged: false, final_step: f64::INFINITY };
         let setup = t0.elapsed().as_secs_f64();
-        for iteration in 0..self.params.max_iterations {
-            let start = Instant::now();
+        let iterations =
+            Iterations { first: 0, count: self.params.max_iterations, tolerance: self.params.tolerance };
+        let factor = self.normal_factor.as_ref();
+        let iterate = |reduced: &mut Mat<f64>, iteration: usize| -> Result<f64, MethodError> {
             // Eq 17–19, then eq 20 (eq 27 with T_2 = W^T L^T W_sigma R_sigma).
             let rotations = model.isoline_rotations(&probes, RotationFit::ScaledOrthogonal);
             let mut rhs = &system.laplacian_rhs * &rotations;
             rhs += &constraints;
-            let stop;
-            (summary, stop) = finish_reduced_iteration(
-                ReducedIteration {
-                    method: "hirm",
-                    iteration,
-                    start,
-                    model,
-                    factor: self.normal_factor.as_ref(),
-                },
-                rhs,
-                &mut self.reduced,
-                &mut probes,
-                rest.bbox_diagonal,
-                self.params.tolerance,
-                observer,
-            )?;
-            if stop {
-                break;
-            }
-        }
+            let it = ReducedIteration { method: "hirm", iteration, model, factor };
+            reduced_step(it, rhs, reduced, &mut probes, rest.bbox_diagonal)
+        };
+        let shape = |reduced: &Mat<f64>| model.positions(reduced.as_ref());
+        let summary = run_iterations(iterations, &mut self.reduced, iterate, shape, observer)?;
         // Eq 21 / 28 for every vertex, once.
         let t1 = Instant::now();
         let current = checked_positions("hirm", model, self.reduced.as_ref(), summary.iterations)?;

@@ -73,8 +73,7 @@ pub fn propagation_fields_at_least(
     seed: u64,
 ) -> Result<PropagationFields, MethodError> {
     let n = positions.len();
-    let mut stiffness = laplacian.clone();
-    stiffness.val_mut().iter_mut().for_each(|v| *v = -*v);
+    let stiffness = crate::operators::stiffness(laplacian.clone());
     let wanted = (max_fields + 1).min(n);
     let floor = (min_fields.min(max_fields) + 1).min(n);
     let mut count = 16.max(floor).min(wanted);

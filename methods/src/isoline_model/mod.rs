@@ -2,7 +2,8 @@
 //! isolines traced on scalar fields ([`tracing`]), one 3x4 transform per isoline interpolated to
 //! the vertices and the Laplacian coordinates ([`interpolation`]: `X = W_x R_x`,
 //! `delta = W_delta R_delta`), the handle-independent and constrained reduced systems, and the
-//! end of one reduced iteration (solve, move the sampled triangles, check, report).
+//! end of one reduced iteration (solve, move the sampled triangles, check; the loop around it is
+//! [`crate::method::run_iterations`]).
 //!
 //! What the two methods differ in stays with them: where the fields come from (harmonic fields
 //! per handle, Laplacian eigenvectors), how the sets are blended ([`SetBlend`]) and how isoline
@@ -10,8 +11,6 @@
 
 pub mod interpolation;
 pub mod tracing;
-
-use std::time::Instant;
 
 use faer::{Mat, MatRef};
 use meshes::vector::{cross, dot, normalize_or_zero, scale, sub};
@@ -22,15 +21,12 @@ pub use interpolation::{
 };
 
 use crate::error::MethodError;
-use crate::method::{IterationObserver, IterationReport, SolveSummary};
 
-/// What [`finish_reduced_iteration`] needs to know of the iteration and the bound model.
+/// What [`reduced_step`] needs to know of the iteration and the bound model.
 pub(crate) struct ReducedIteration<'a> {
     pub method: &'static str,
     /// 0-based index within the solve.
     pub iteration: usize,
-    /// When the iteration's own work started.
-    pub start: Instant,
     pub model: &'a IsolineModel,
     /// `L` of `U^T U = L L^T` (lower triangle; the strict upper one is not read).
     pub factor: MatRef<'a, f64>,
@@ -54,18 +50,15 @@ pub(crate) fn check_divergence(method: &'static str, iteration: usize, step: f64
 
 /// The end of one iteration of an isoline reduced model (Au et al. 2007 eq 10, HIRM eq 20): solve
 /// `U^T U R = rhs` (`4N x 3`) into `reduced`, move the probe vertices (`probes`, the sampled
-/// triangles' corners) and check them, report the step (largest probe displacement over `diagonal`)
-/// and the iteration time to `observer`. Returns the summary so far and whether to stop (converged
-/// below `tolerance`, or the observer asked).
-pub(crate) fn finish_reduced_iteration(
+/// triangles' corners) and check them. Returns the step: the largest probe displacement over
+/// `diagonal`. Errors: a non-finite probe, or a divergent step ([`check_divergence`]).
+pub(crate) fn reduced_step(
     it: ReducedIteration<'_>,
     mut rhs: Mat<f64>,
     reduced: &mut Mat<f64>,
     probes: &mut Vec<[f64; 3]>,
     diagonal: f64,
-    tolerance: f64,
-    observer: &mut dyn IterationObserver,
-) -> Result<(SolveSummary, bool), MethodError> {
+) -> Result<f64, MethodError> {
     faer::linalg::cholesky::llt::solve::solve_in_place_with_conj(
         it.factor,
         faer::Conj::No,
@@ -82,12 +75,7 @@ pub(crate) fn finish_reduced_iteration(
     let step = crate::method::max_displacement(probes, &next) / diagonal;
     check_divergence(it.method, it.iteration, step)?;
     *probes = next;
-    let report = IterationReport { iteration: it.iteration, step, seconds: it.start.elapsed().as_secs_f64() };
-    let summary =
-        SolveSummary { iterations: it.iteration + 1, converged: step < tolerance, final_step: step };
-    let (model, reduced) = (it.model, &*reduced);
-    let flow = observer.on_iteration(&report, &|| model.positions(reduced.as_ref()));
-    Ok((summary, summary.converged || flow.is_break()))
+    Ok(step)
 }
 
 #[cfg(test)]

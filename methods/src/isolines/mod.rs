@@ -57,11 +57,10 @@ pub use harmonic_fields::harmonic_fields;
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
 use crate::isoline_model::{
-    checked_positions, finish_reduced_iteration, IsolineModel, ReducedIteration, ReducedSystem, RotationFit,
-    SetBlend,
+    checked_positions, reduced_step, IsolineModel, ReducedIteration, ReducedSystem, RotationFit, SetBlend,
 };
 use crate::laplacian_coordinates::RotationInvariantCoordinates;
-use crate::method::{DeformationMethod, IterationObserver, SolveSummary};
+use crate::method::{run_iterations, DeformationMethod, IterationObserver, Iterations, SolveSummary};
 use crate::operators::{laplacian, LaplacianWeights};
 
 /// How the Laplacian coordinates of eq 1 are evaluated in the reduced iteration.
@@ -275,10 +274,10 @@ impl DeformationMethod for Isolines {
         let mut probes = bound.model.probe_positions(self.reduced.as_ref());
         let mut delta =
             Mat::<f64>::zeros(if bound.coordinates.is_some() { self.current.len() } else { 0 }, 3);
-        let mut summary = SolveSummary { iterations: 0, converged: false, final_step: f64::INFINITY };
         let setup = t0.elapsed().as_secs_f64();
-        for iteration in 0..self.params.max_iterations {
-            let start = Instant::now();
+        let iterations =
+            Iterations { first: 0, count: self.params.max_iterations, tolerance: self.params.tolerance };
+        let iterate = |reduced: &mut Mat<f64>, iteration: usize| -> Result<f64, MethodError> {
             let mut rhs = constraint_rhs.clone();
             match &mut bound.coordinates {
                 None => {
@@ -286,7 +285,7 @@ impl DeformationMethod for Isolines {
                     rhs += &bound.system.laplacian_rhs * &rotations;
                 }
                 Some(coordinates) => {
-                    let shape = bound.model.positions(self.reduced.as_ref());
+                    let shape = bound.model.positions(reduced.as_ref());
                     coordinates.evaluate(&shape, delta.as_mut());
                     rhs += bound.system.laplacian_rhs_full(
                         &bound.model,
@@ -295,26 +294,12 @@ impl DeformationMethod for Isolines {
                     );
                 }
             }
-            let stop;
-            (summary, stop) = finish_reduced_iteration(
-                ReducedIteration {
-                    method: name,
-                    iteration,
-                    start,
-                    model: &bound.model,
-                    factor: bound.factor.L(),
-                },
-                rhs,
-                &mut self.reduced,
-                &mut probes,
-                rest.bbox_diagonal,
-                self.params.tolerance,
-                observer,
-            )?;
-            if stop {
-                break;
-            }
-        }
+            let it =
+                ReducedIteration { method: name, iteration, model: &bound.model, factor: bound.factor.L() };
+            reduced_step(it, rhs, reduced, &mut probes, rest.bbox_diagonal)
+        };
+        let shape = |reduced: &Mat<f64>| bound.model.positions(reduced.as_ref());
+        let summary = run_iterations(iterations, &mut self.reduced, iterate, shape, observer)?;
         let t1 = Instant::now();
         self.current = checked_positions(name, &bound.model, self.reduced.as_ref(), summary.iterations)?;
         self.timings.retain(|(k, _)| !k.starts_with(crate::keys::phase::SOLVE_PREFIX));

@@ -82,6 +82,15 @@ pub fn laplacian(
     })
 }
 
+/// The stiffness matrix `K = -L` (`#V x #V`, same sparsity) of a Laplacian `laplacian` in
+/// [`laplacian`]'s sign convention: symmetric positive semi-definite for non-negative weights, with
+/// `K 1 = 0`. What the energies `x^T K x`, the ARAP system and the eigenproblem `K phi = lambda M phi`
+/// are written with.
+pub fn stiffness(mut laplacian: SparseColMat<usize, f64>) -> SparseColMat<usize, f64> {
+    laplacian.val_mut().iter_mut().for_each(|v| *v = -*v);
+    laplacian
+}
+
 /// `#V` lumped mass diagonal that goes with [`laplacian`] for these `weights`: the mesh's
 /// [`lumped_mass`] for `Cotan` and `Clamped` (their mesh is the mesh), the intrinsic triangles' for
 /// `IntrinsicDelaunay` (same total area, distributed over the intrinsic faces).

@@ -71,8 +71,8 @@ use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
 use crate::laplacian::{LaplacianEditing, LaplacianParams};
 use crate::method::{
-    finish_iteration, max_displacement, move_to, report_iteration, DeformationMethod, IterationObserver,
-    IterationReport, NoObserver, SolveSummary,
+    max_displacement, move_to, run_iterations, DeformationMethod, IterationObserver, IterationReport,
+    Iterations, NoObserver, SolveSummary,
 };
 use crate::operators::LaplacianWeights;
 use crate::rotation_fit::Mat3;
@@ -394,52 +394,45 @@ impl DeformationMethod for ScaleAware {
         let step = max_displacement(&before, &self.current) / diagonal;
         let report = IterationReport { iteration: 0, step, seconds: self.timings.initialization };
         let current: &[[f64; 3]] = &self.current;
-        let mut summary = SolveSummary { iterations: 1, converged: false, final_step: step };
+        let summary = SolveSummary { iterations: 1, converged: false, final_step: step };
         if observer.on_iteration(&report, &|| current.to_vec()) == ControlFlow::Break(()) {
             return Ok(summary);
         }
 
         // Algorithm 1: x <- T(x), T = step two after step one, optionally Anderson-accelerated.
         let mut anderson = AndersonAcceleration::new(self.params.anderson_depth, 3 * self.current.len());
-        for iteration in 1..=self.params.max_iterations {
+        let iterations =
+            Iterations { first: 1, count: self.params.max_iterations, tolerance: self.params.tolerance };
+        let iterate = |m: &mut Self, iteration: usize| -> Result<f64, MethodError> {
             let start = Instant::now();
-            self.update_normals();
-            self.timings.step_one_normals += start.elapsed().as_secs_f64();
-            self.recover_vertices(targets)?;
-            self.timings.outer_iterations += 1;
+            m.update_normals();
+            m.timings.step_one_normals += start.elapsed().as_secs_f64();
+            m.recover_vertices(targets)?;
+            m.timings.outer_iterations += 1;
             // The fixed-point residual |T(x) - x| is the plain iteration's step.
-            let residual = max_displacement_to(&self.current, self.solution.as_ref()) / diagonal;
-            if residual >= self.params.tolerance && self.params.anderson_depth > 0 {
-                self.accelerate(&mut anderson);
+            let residual = max_displacement_to(&m.current, m.solution.as_ref()) / diagonal;
+            if residual >= m.params.tolerance && m.params.anderson_depth > 0 {
+                m.accelerate(&mut anderson);
             }
-            move_to(self.name, iteration, &mut self.current, self.solution.as_ref())?;
-            let stop;
-            (summary, stop) =
-                report_iteration(iteration, start, residual, &self.current, self.params.tolerance, observer);
-            if stop {
-                break;
-            }
-        }
+            move_to(m.name, iteration, &mut m.current, m.solution.as_ref())?;
+            Ok(residual)
+        };
+        let summary = run_iterations(iterations, self, iterate, |m| m.current.clone(), observer)?;
 
-        if self.params.optimal_rigidity {
-            let start = Instant::now();
-            self.approximate_rigidity(targets)?;
-            self.timings.stitching = start.elapsed().as_secs_f64();
-            let iteration = summary.iterations;
-            // The stitching step is no convergence test: a tolerance of infinity never fails it.
-            let (done, _) = finish_iteration(
-                self.name,
-                iteration,
-                start,
-                &mut self.current,
-                self.solution.as_ref(),
-                diagonal,
-                f64::INFINITY,
-                observer,
-            )?;
-            summary = SolveSummary { iterations: done.iterations, converged: summary.converged, ..summary };
+        if !self.params.optimal_rigidity {
+            return Ok(summary);
         }
-        Ok(summary)
+        // The stitching step is no convergence test: a tolerance of infinity never fails it.
+        let stitching = Iterations { first: summary.iterations, count: 1, tolerance: f64::INFINITY };
+        let stitch = |m: &mut Self, iteration: usize| -> Result<f64, MethodError> {
+            let start = Instant::now();
+            m.approximate_rigidity(targets)?;
+            let step = move_to(m.name, iteration, &mut m.current, m.solution.as_ref())? / diagonal;
+            m.timings.stitching = start.elapsed().as_secs_f64();
+            Ok(step)
+        };
+        let done = run_iterations(stitching, self, stitch, |m| m.current.clone(), observer)?;
+        Ok(SolveSummary { iterations: done.iterations, converged: summary.converged, ..summary })
     }
 
     fn positions(&self) -> Vec<[f64; 3]> {

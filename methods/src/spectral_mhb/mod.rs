@@ -220,8 +220,7 @@ impl DeformationMethod for SpectralMhb {
         // PT1: manifold harmonics bases.
         let start = Instant::now();
         let laplacian = laplacian(self.params.weights, p, tris)?;
-        let mut stiffness = laplacian.clone();
-        stiffness.val_mut().iter_mut().for_each(|v| *v = -*v);
+        let stiffness = crate::operators::stiffness(laplacian.clone());
         let mhb_mass = lumped_mass_for(self.params.weights, p, tris, MassKind::Barycentric)?;
         let m = self.params.bases.min(n);
         let mut options = EigenOptions::new(m);
@@ -271,8 +270,7 @@ impl DeformationMethod for SpectralMhb {
         self.details = Some(match self.params.details {
             DetailTransfer::DeformationTransfer => {
                 // The mesh's own -L (see the module documentation): G^T A G of the mesh gradients.
-                let mut poisson = crate::operators::cotan_laplacian(p, tris);
-                poisson.val_mut().iter_mut().for_each(|v| *v = -*v);
+                let poisson = crate::operators::stiffness(crate::operators::cotan_laplacian(p, tris));
                 Details::Transfer(DeformationTransfer::new(p, &self.smoothed_rest, tris, &poisson)?)
             }
             DetailTransfer::LocalFrames => {
