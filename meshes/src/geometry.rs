@@ -1,37 +1,9 @@
 //! Per-element geometry: face areas and normals, corner angles, dihedral angles, vertex normals.
 //! Functions take positions and triangles separately so they apply to deformed positions as well.
 
+pub use crate::primitives::{bbox, bbox_diagonal, triangle_area};
 use crate::topology::Topology;
 use crate::vector::{angle_between, cross, norm, normalize_or_zero, sub};
-
-/// Corners `(min, max)` of the axis-aligned bounding box of `#V x 3` positions (infinite for no
-/// points).
-pub fn bbox(positions: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in positions {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (lo, hi)
-}
-
-/// Diagonal of the axis-aligned bounding box of `#V x 3` positions (0 for no points).
-pub fn bbox_diagonal(positions: &[[f64; 3]]) -> f64 {
-    if positions.is_empty() {
-        return 0.0;
-    }
-    let (lo, hi) = bbox(positions);
-    norm(sub(hi, lo))
-}
-
-/// Area of triangle `tri` of `positions`.
-pub fn triangle_area(positions: &[[f64; 3]], tri: &[u32; 3]) -> f64 {
-    let [a, b, c] = tri.map(|i| positions[i as usize]);
-    0.5 * norm(cross(sub(b, a), sub(c, a)))
-}
 
 /// `#F` face areas.
 pub fn face_areas(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<f64> {

@@ -76,12 +76,12 @@ impl TriMesh {
 
     /// Corners `(min, max)` of the axis-aligned bounding box.
     pub fn bbox(&self) -> ([f64; 3], [f64; 3]) {
-        crate::geometry::bbox(&self.positions)
+        crate::primitives::bbox(&self.positions)
     }
 
     /// Diagonal length of the axis-aligned bounding box.
     pub fn bbox_diagonal(&self) -> f64 {
-        crate::geometry::bbox_diagonal(&self.positions)
+        crate::primitives::bbox_diagonal(&self.positions)
     }
 
     /// Reject faces whose area is at most `1e-12 x (bbox diagonal)^2`: they have no normal and no angles.
@@ -89,7 +89,7 @@ impl TriMesh {
         let d = self.bbox_diagonal();
         let threshold = 1e-12 * d * d;
         for (f, t) in self.triangles.iter().enumerate() {
-            let area = crate::geometry::triangle_area(&self.positions, t);
+            let area = crate::primitives::triangle_area(&self.positions, t);
             if !(area > threshold) {
                 return Err(MeshError::DegenerateFace { face: f, area });
             }

@@ -1,96 +1,40 @@
-//! Horizontal glyph metrics (advance width, left side bearing) read from the TrueType font file, so
-//! that labels can be set glyph by glyph. plotters' `ab_glyph` text drops each glyph's left side
-//! bearing and truncates the pen position per glyph, which spaces letters visibly unevenly at figure
-//! sizes ("tin y"); plotters still rasterizes every glyph.
+//! Horizontal glyph metrics (advance width, left side bearing) of the figure font, so that labels
+//! can be set glyph by glyph. plotters' `ab_glyph` text drops each glyph's left side bearing and
+//! truncates the pen position per glyph, which spaces letters visibly unevenly at figure sizes
+//! ("tin y"); plotters still rasterizes every glyph.
 //!
-//! Only what that needs is read: `head` (units per em), `hhea` and `hmtx` (metrics) and a format-4
-//! `cmap` subtable (characters of the Basic Multilingual Plane). A font without them gives `None`,
+//! The font is read with `ttf-parser` (the parser under `ab_glyph`, so plotters and these metrics
+//! agree on the file). Only the `hmtx` and `cmap` tables are used; a font without them gives `None`,
 //! and the labels fall back to plotters' own placement.
 
-use std::path::Path;
+use ttf_parser::{Face, GlyphId};
 
-/// Metrics of one font file, in font units.
+/// Metrics of one font, in font units, borrowing the font file's bytes.
 #[derive(Clone, Debug)]
-pub struct GlyphMetrics {
-    data: Vec<u8>,
-    /// Offsets of the `hmtx` table and of the format-4 `cmap` subtable.
-    hmtx: usize,
-    cmap4: usize,
-    n_h_metrics: usize,
-    n_glyphs: usize,
+pub struct GlyphMetrics<'a> {
+    face: Face<'a>,
 }
 
-impl GlyphMetrics {
-    /// Read the font file at `path`; `None` when it cannot be read or lacks a table used here.
-    pub fn load(path: &Path) -> Option<GlyphMetrics> {
-        GlyphMetrics::parse(std::fs::read(path).ok()?)
-    }
-
-    /// Parse the bytes of a TrueType / OpenType file (not a collection).
-    pub fn parse(data: Vec<u8>) -> Option<GlyphMetrics> {
-        let n_tables = u16_at(&data, 4)? as usize;
-        let table = |tag: &[u8; 4]| {
-            (0..n_tables).map(|i| 12 + 16 * i).find(|&r| data.get(r..r + 4) == Some(&tag[..])).and_then(|r| {
-                let offset = u32_at(&data, r + 8)? as usize;
-                let length = u32_at(&data, r + 12)? as usize;
-                (offset.checked_add(length)? <= data.len()).then_some(offset)
-            })
-        };
-        let (hhea, hmtx, maxp, cmap) = (table(b"hhea")?, table(b"hmtx")?, table(b"maxp")?, table(b"cmap")?);
-        let n_h_metrics = u16_at(&data, hhea + 34)? as usize;
-        let n_glyphs = u16_at(&data, maxp + 4)? as usize;
-        let n_encodings = u16_at(&data, cmap + 2)? as usize;
-        // Unicode BMP subtables: Windows (3, 1) or Unicode (0, 3); both are format 4 in practice.
-        let cmap4 = (0..n_encodings).find_map(|i| {
-            let record = cmap + 4 + 8 * i;
-            let ids = (u16_at(&data, record)?, u16_at(&data, record + 2)?);
-            let sub = cmap.checked_add(u32_at(&data, record + 4)? as usize)?;
-            (matches!(ids, (3, 1) | (0, 3)) && u16_at(&data, sub)? == 4).then_some(sub)
-        })?;
-        let metrics = GlyphMetrics { data, hmtx, cmap4, n_h_metrics, n_glyphs };
-        // Every offset read later must be inside the file; check the ends of both tables once.
-        (n_h_metrics > 0 && metrics.h_metrics(n_glyphs.saturating_sub(1) as u16).is_some()).then_some(metrics)
+impl<'a> GlyphMetrics<'a> {
+    /// Parse the bytes of a TrueType / OpenType file (the first face of a collection, as plotters
+    /// takes); `None` when they are not a font or it has no `hmtx` or `cmap` table.
+    pub fn parse(data: &'a [u8]) -> Option<GlyphMetrics<'a>> {
+        let face = Face::parse(data, 0).ok()?;
+        // ttf-parser parses without them, but then every lookup below would fail.
+        (face.tables().hmtx.is_some() && face.tables().cmap.is_some()).then_some(GlyphMetrics { face })
     }
 
     /// Glyph index of `c`; `None` for a character the font does not have.
     pub fn glyph(&self, c: char) -> Option<u16> {
-        let c = u16::try_from(c as u32).ok()?;
-        let d = &self.data;
-        let t = self.cmap4;
-        let seg_x2 = u16_at(d, t + 6)? as usize;
-        let (ends, starts) = (t + 14, t + 16 + seg_x2);
-        let (deltas, ranges) = (starts + seg_x2, starts + 2 * seg_x2);
-        let seg = (0..seg_x2 / 2).find(|&s| u16_at(d, ends + 2 * s).is_some_and(|end| end >= c))?;
-        let start = u16_at(d, starts + 2 * seg)?;
-        if c < start {
-            return None;
-        }
-        let delta = u16_at(d, deltas + 2 * seg)?;
-        let range = u16_at(d, ranges + 2 * seg)? as usize;
-        let glyph = if range == 0 {
-            c.wrapping_add(delta)
-        } else {
-            // idRangeOffset counts bytes from its own position into glyphIdArray.
-            match u16_at(d, ranges + 2 * seg + range + 2 * (c - start) as usize)? {
-                0 => 0,
-                g => g.wrapping_add(delta),
-            }
-        };
-        (glyph != 0 && (glyph as usize) < self.n_glyphs).then_some(glyph)
+        // A format-4 segment can map a character to glyph 0 (`.notdef`), the font's "missing" box:
+        // that is a character the font does not have, so the label falls back to plotters.
+        self.face.glyph_index(c).map(|g| g.0).filter(|&g| g != 0 && g < self.face.number_of_glyphs())
     }
 
     /// `(advance width, left side bearing)` of glyph `g`, in font units.
     pub fn h_metrics(&self, g: u16) -> Option<(u16, i16)> {
-        let g = g as usize;
-        let last = self.n_h_metrics - 1;
-        // Glyphs past the last full record share its advance and list only their bearing.
-        let advance = u16_at(&self.data, self.hmtx + 4 * g.min(last))?;
-        let lsb = if g <= last {
-            u16_at(&self.data, self.hmtx + 4 * g + 2)?
-        } else {
-            u16_at(&self.data, self.hmtx + 4 * self.n_h_metrics + 2 * (g - self.n_h_metrics))?
-        };
-        Some((advance, lsb as i16))
+        let g = GlyphId(g);
+        Some((self.face.glyph_hor_advance(g)?, self.face.glyph_hor_side_bearing(g)?))
     }
 
     /// Advance width in font units of `text`; `None` if a character is missing.
@@ -99,22 +43,18 @@ impl GlyphMetrics {
     }
 }
 
-fn u16_at(data: &[u8], at: usize) -> Option<u16> {
-    Some(u16::from_be_bytes(data.get(at..at.checked_add(2)?)?.try_into().ok()?))
-}
-
-fn u32_at(data: &[u8], at: usize) -> Option<u32> {
-    Some(u32::from_be_bytes(data.get(at..at.checked_add(4)?)?.try_into().ok()?))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    fn font_bytes() -> Vec<u8> {
+        std::fs::read(crate::report::fonts::register_sans_serif().unwrap()).unwrap()
+    }
+
     #[test]
     fn the_registered_font_maps_characters_and_has_bearings() {
-        let path = crate::report::fonts::register_sans_serif().unwrap();
-        let m = GlyphMetrics::load(path).expect("the figure font has hmtx and a format-4 cmap");
+        let data = font_bytes();
+        let m = GlyphMetrics::parse(&data).expect("the figure font has hmtx and cmap");
         for c in ['a', 'i', 'n', 'E', '0', '\u{3b8}', '\u{3c6}', '\u{b0}', '\u{2265}', ' '] {
             assert!(m.glyph(c).is_some(), "{c:?}");
         }
@@ -126,14 +66,57 @@ mod tests {
         assert!(m.advance("nn").unwrap() == 2.0 * m.h_metrics(n).unwrap().0 as f64);
     }
 
+    /// `Face::glyph_index` tries every Unicode subtable; on the Basic Multilingual Plane it must give
+    /// what the font's Windows BMP (3, 1) format-4 subtable alone gives, which is what the labels
+    /// were set from before ttf-parser was used. And the metrics are the `hmtx` records.
+    #[test]
+    fn lookups_match_the_fonts_bmp_subtable_and_hmtx() {
+        use ttf_parser::cmap::Format;
+        use ttf_parser::PlatformId;
+        let data = font_bytes();
+        let m = GlyphMetrics::parse(&data).unwrap();
+        let face = Face::parse(&data, 0).unwrap();
+        let bmp = face
+            .tables()
+            .cmap
+            .unwrap()
+            .subtables
+            .into_iter()
+            .find_map(|s| match s.format {
+                Format::SegmentMappingToDeltaValues(t)
+                    if s.platform_id == PlatformId::Windows && s.encoding_id == 1 =>
+                {
+                    Some(t)
+                }
+                _ => None,
+            })
+            .expect("the figure font has a Windows BMP format-4 cmap");
+        let hmtx = face.tables().hmtx.unwrap();
+        let mut mapped = 0;
+        for c in (0..=0xffffu32).filter_map(char::from_u32) {
+            let expected = bmp.glyph_index(c as u32).map(|g| g.0).filter(|&g| g != 0);
+            assert_eq!(m.glyph(c), expected, "{c:?}");
+            if let Some(g) = expected {
+                let record = (hmtx.advance(GlyphId(g)).unwrap(), hmtx.side_bearing(GlyphId(g)).unwrap());
+                assert_eq!(m.h_metrics(g), Some(record), "{c:?}");
+                mapped += 1;
+            }
+        }
+        assert!(mapped > 1000, "{mapped} characters mapped");
+        let digits = "0123456789";
+        let sum: f64 =
+            digits.chars().map(|c| hmtx.advance(GlyphId(m.glyph(c).unwrap())).unwrap() as f64).sum();
+        assert_eq!(m.advance(digits), Some(sum));
+    }
+
     #[test]
     fn garbage_is_rejected_without_panicking() {
-        assert!(GlyphMetrics::parse(Vec::new()).is_none());
-        assert!(GlyphMetrics::parse(vec![0xff; 64]).is_none());
+        assert!(GlyphMetrics::parse(&[]).is_none());
+        assert!(GlyphMetrics::parse(&[0xff; 64]).is_none());
         let mut header = vec![0u8; 12 + 16];
         header[5] = 1;
         header[12..16].copy_from_slice(b"hhea");
         header[20..24].copy_from_slice(&u32::MAX.to_be_bytes());
-        assert!(GlyphMetrics::parse(header).is_none());
+        assert!(GlyphMetrics::parse(&header).is_none());
     }
 }

@@ -86,10 +86,16 @@ fn font(size: f64) -> FontDesc<'static> {
 }
 
 /// The figure font's metrics, read once; `None` if the font file lacks what [`GlyphMetrics`] reads.
-fn metrics() -> Option<&'static GlyphMetrics> {
-    static METRICS: OnceLock<Option<GlyphMetrics>> = OnceLock::new();
+fn metrics() -> Option<&'static GlyphMetrics<'static>> {
+    // The metrics borrow the file's bytes, so both live for the process, like plotters' copy.
+    static DATA: OnceLock<Option<Vec<u8>>> = OnceLock::new();
+    static METRICS: OnceLock<Option<GlyphMetrics<'static>>> = OnceLock::new();
     METRICS
-        .get_or_init(|| crate::report::fonts::register_sans_serif().ok().and_then(GlyphMetrics::load))
+        .get_or_init(|| {
+            let data =
+                DATA.get_or_init(|| std::fs::read(crate::report::fonts::register_sans_serif().ok()?).ok());
+            GlyphMetrics::parse(data.as_deref()?)
+        })
         .as_ref()
 }
 
