@@ -332,6 +332,7 @@ impl DeformationMethod for Arap {
         else {
             return Err(MethodError::Phase { method: "arap", phase: "solve", missing: "bind_handles" });
         };
+        targets.check_for(handles)?;
         for (v, t) in handles.constrained().zip(targets.positions()) {
             self.current[v as usize] = *t;
         }

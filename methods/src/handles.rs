@@ -95,6 +95,9 @@ impl HandleSet {
 #[derive(Clone, Debug, PartialEq)]
 pub struct HandleTargets {
     positions: Vec<[f64; 3]>,
+    /// The constrained vertices of the handle set they were made for, in the same order: a method
+    /// checks them against the set it has bound ([`HandleTargets::check_for`]).
+    vertices: Vec<u32>,
 }
 
 impl HandleTargets {
@@ -112,11 +115,32 @@ impl HandleTargets {
                 return Err(MethodError::Targets(format!("target of vertex {v} is not finite: {p:?}")));
             }
         }
-        Ok(Self { positions })
+        Ok(Self { positions, vertices: handles.constrained().collect() })
     }
 
     /// Targets in [`HandleSet::constrained`] order.
     pub fn positions(&self) -> &[[f64; 3]] {
         &self.positions
+    }
+
+    /// Fails with [`MethodError::Targets`] unless these targets were made for the constrained
+    /// vertices of `handles` (the set a method has bound), in its order: targets of another set
+    /// would move the wrong vertices, or index past the constrained ones.
+    pub fn check_for(&self, handles: &HandleSet) -> Result<(), MethodError> {
+        if self.vertices.len() != handles.n_constrained() {
+            return Err(MethodError::Targets(format!(
+                "{} targets for the bound handle set's {} constrained vertices",
+                self.vertices.len(),
+                handles.n_constrained()
+            )));
+        }
+        let mut pairs = self.vertices.iter().copied().zip(handles.constrained()).enumerate();
+        match pairs.find(|(_, (made_for, bound))| made_for != bound) {
+            None => Ok(()),
+            Some((k, (made_for, bound))) => Err(MethodError::Targets(format!(
+                "targets were made for another handle set: target {k} is for vertex {made_for}, the \
+                 bound set's constrained vertex {k} is {bound}"
+            ))),
+        }
     }
 }

@@ -172,9 +172,10 @@ impl DeformationMethod for LaplacianEditing {
         targets: &HandleTargets,
         observer: &mut dyn IterationObserver,
     ) -> Result<SolveSummary, MethodError> {
-        if self.handles.is_none() {
+        let Some(handles) = &self.handles else {
             return Err(MethodError::Phase { method: "laplacian", phase: "solve", missing: "bind_handles" });
-        }
+        };
+        targets.check_for(handles)?;
         let w2 = self.params.omega * self.params.omega;
         let iterations =
             Iterations { first: 0, count: self.params.max_iterations, tolerance: self.params.tolerance };

@@ -3,8 +3,9 @@
 //! background precompute (same matrices as a synchronous one), incremental binding (a new handle set
 //! starts from the current shape, which is a fixed point), and clear errors.
 
-use meshes::shapes::{generate, ShapeKind};
-use meshes::{TriMesh, VertexStatus};
+mod fixtures;
+
+use meshes::TriMesh;
 use methods::hirm::{handle_independent_model, propagation_fields, select_fields, Hirm, HirmParams};
 use methods::operators::cotan_laplacian;
 use methods::{DeformationMethod, HandleRegion, HandleSet, HandleTargets, MethodError, NoObserver};
@@ -31,16 +32,11 @@ fn strip(length: f64, cells: usize) -> TriMesh {
     TriMesh::new(positions.collect(), triangles).unwrap()
 }
 
-/// Procedural bar (~2K vertices) with its fixed and handle regions.
+/// The fixture's bar (~2K vertices) with its fixed and handle regions.
 fn bar() -> (TriMesh, HandleSet) {
-    let shape = generate(ShapeKind::Bar, 2000).unwrap();
-    let region = |name: &str, status| HandleRegion {
-        name: name.into(),
-        vertices: meshes::edit::vertices_with_status(&shape.selection, status),
-    };
-    let regions = vec![region("fixed", VertexStatus::Fixed), region("handle", VertexStatus::Handle)];
-    let handles = HandleSet::new(regions, shape.mesh.n_vertices()).unwrap();
-    (shape.mesh, handles)
+    let bar = fixtures::bar(2000);
+    let handles = bar.handles();
+    (bar.mesh, handles)
 }
 
 /// Targets: `fixed` where it is in `current`, `handle` moved by `offset`.

@@ -2,43 +2,20 @@
 //! unity), traced isolines (segment ends on the level), the interpolation matrices (identity transforms
 //! reproduce the base shape and its Laplacian coordinates), fixed points and clear errors.
 
-use meshes::shapes::{generate, ShapeKind};
-use meshes::{AffineTransform, TriMesh, VertexStatus};
+mod fixtures;
+
+use meshes::{AffineTransform, TriMesh};
 use methods::isoline_model::tracing::trace_isoline;
 use methods::isolines::{harmonic_fields, Isolines, IsolinesParams, LaplacianCoordinates};
 use methods::operators::cotan_laplacian;
-use methods::{DeformationMethod, HandleRegion, HandleSet, HandleTargets, MethodError, NoObserver};
+use methods::{DeformationMethod, HandleSet, HandleTargets, MethodError, NoObserver};
 
-/// Procedural bar (~2K vertices) with its fixed and handle regions, and optionally a third handle:
-/// the free vertices at 45–50% of the bar's length (a ring in its middle).
+/// The fixture's bar (~2K vertices) with its fixed and handle regions, and optionally a third
+/// handle: the free vertices at 45–50% of the bar's length (a ring in its middle).
 fn bar(three_handles: bool) -> (TriMesh, HandleSet) {
-    let shape = generate(ShapeKind::Bar, 2000).unwrap();
-    let fixed = meshes::edit::vertices_with_status(&shape.selection, VertexStatus::Fixed);
-    let handle = meshes::edit::vertices_with_status(&shape.selection, VertexStatus::Handle);
-    let mut regions = vec![
-        HandleRegion { name: "fixed".into(), vertices: fixed },
-        HandleRegion { name: "handle".into(), vertices: handle },
-    ];
-    if three_handles {
-        let p = shape.mesh.positions();
-        let extent =
-            |a: usize| p.iter().fold((f64::MAX, f64::MIN), |(lo, hi), q| (lo.min(q[a]), hi.max(q[a])));
-        let axis = (0..3).max_by(|&a, &b| {
-            let (ea, eb) = (extent(a), extent(b));
-            (ea.1 - ea.0).total_cmp(&(eb.1 - eb.0))
-        });
-        let axis = axis.unwrap();
-        let (lo, hi) = extent(axis);
-        let middle = (0..p.len() as u32)
-            .filter(|&v| {
-                let s = (p[v as usize][axis] - lo) / (hi - lo);
-                (0.45..=0.5).contains(&s) && shape.selection[v as usize] == VertexStatus::Free
-            })
-            .collect();
-        regions.push(HandleRegion { name: "middle".into(), vertices: middle });
-    }
-    let handles = HandleSet::new(regions, shape.mesh.n_vertices()).unwrap();
-    (shape.mesh, handles)
+    let bar = fixtures::bar(2000);
+    let handles = if three_handles { bar.three_handles() } else { bar.handles() };
+    (bar.mesh, handles)
 }
 
 fn method(params: IsolinesParams) -> Isolines {

@@ -2,8 +2,10 @@
 //! fixed points, rigid invariance, constraint satisfaction, incremental binding, determinism, and
 //! clear errors for bad input.
 
-use meshes::shapes::{generate, ShapeKind};
-use meshes::{AffineTransform, TriMesh, VertexStatus};
+mod fixtures;
+
+use fixtures::Bar;
+use meshes::{AffineTransform, TriMesh};
 use methods::registry::create;
 use methods::{HandleRegion, HandleSet, HandleTargets, MethodError, NoObserver};
 
@@ -13,25 +15,9 @@ fn params(text: &str) -> toml::Table {
     text.parse().unwrap()
 }
 
-/// Procedural bar (~1.5K vertices) with its survey-style fixed and handle regions.
-fn bar() -> (TriMesh, HandleSet, Vec<u32>, Vec<u32>) {
-    let shape = generate(ShapeKind::Bar, 1500).unwrap();
-    let fixed = meshes::edit::vertices_with_status(&shape.selection, VertexStatus::Fixed);
-    let handle = meshes::edit::vertices_with_status(&shape.selection, VertexStatus::Handle);
-    let handles = HandleSet::new(
-        vec![
-            HandleRegion { name: "fixed".into(), vertices: fixed.clone() },
-            HandleRegion { name: "handle".into(), vertices: handle.clone() },
-        ],
-        shape.mesh.n_vertices(),
-    )
-    .unwrap();
-    (shape.mesh, handles, fixed, handle)
-}
-
-fn targets_by(mesh: &TriMesh, handles: &HandleSet, f: impl Fn(u32, [f64; 3]) -> [f64; 3]) -> HandleTargets {
-    let t = handles.constrained().map(|v| f(v, mesh.positions()[v as usize])).collect();
-    HandleTargets::new(handles, t).unwrap()
+/// The fixture's bar at ~1.5K vertices, with its survey-style fixed and handle regions.
+fn bar() -> Bar {
+    fixtures::bar(1500)
 }
 
 fn max_distance(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
@@ -48,10 +34,11 @@ fn run(name: &str, p: &str, mesh: &TriMesh, handles: &HandleSet, targets: &Handl
 
 #[test]
 fn rest_shape_is_a_fixed_point() {
-    let (mesh, handles, _, _) = bar();
-    let targets = targets_by(&mesh, &handles, |_, p| p);
+    let bar = bar();
+    let (mesh, handles) = (&bar.mesh, bar.handles());
+    let targets = bar.rest_targets(&handles);
     for name in REFERENCE {
-        let x = run(name, "", &mesh, &handles, &targets);
+        let x = run(name, "", mesh, &handles, &targets);
         let d = max_distance(&x, mesh.positions()) / mesh.bbox_diagonal();
         assert!(d < 1e-9, "{name}: rest shape moved by {d:e} x diagonal");
     }
@@ -59,16 +46,17 @@ fn rest_shape_is_a_fixed_point() {
 
 #[test]
 fn rigid_motion_of_all_handles_moves_the_mesh_rigidly() {
-    let (mesh, handles, _, _) = bar();
+    let bar = bar();
+    let (mesh, handles) = (&bar.mesh, bar.handles());
     let rigid = AffineTransform::rotation_about([0.3, 1.0, 0.2], 0.5, [1.0, 2.0, 40.0])
         .compose(&AffineTransform::translation([3.0, -1.0, 2.0]));
-    let targets = targets_by(&mesh, &handles, |_, p| rigid.apply(p));
+    let targets = bar.targets_by(&handles, |_, p| rigid.apply(p));
     let expected: Vec<[f64; 3]> = mesh.positions().iter().map(|&p| rigid.apply(p)).collect();
     for (name, p, tol) in [
         ("arap", "max_iterations = 300\ntolerance = 1e-10", 1e-6),
         ("laplacian", "max_iterations = 3000\ntolerance = 1e-10", 1e-4),
     ] {
-        let x = run(name, p, &mesh, &handles, &targets);
+        let x = run(name, p, mesh, &handles, &targets);
         let d = max_distance(&x, &expected) / mesh.bbox_diagonal();
         assert!(d < tol, "{name}: result is {d:e} x diagonal from the rigidly moved mesh");
     }
@@ -76,12 +64,13 @@ fn rigid_motion_of_all_handles_moves_the_mesh_rigidly() {
 
 #[test]
 fn handle_constraints_are_met() {
-    let (mesh, handles, _, handle) = bar();
+    let bar = bar();
+    let (mesh, handles) = (&bar.mesh, bar.handles());
     let twist = AffineTransform::rotation_about([0.0, 0.0, 1.0], 1.0, [0.0, 0.0, 0.0]);
-    let targets = targets_by(&mesh, &handles, |v, p| if handle.contains(&v) { twist.apply(p) } else { p });
+    let targets = bar.handle_moved_by(&handles, &twist);
     let diag = mesh.bbox_diagonal();
     for (name, tol) in [("arap", 1e-9), ("laplacian", 1e-3)] {
-        let x = run(name, "", &mesh, &handles, &targets);
+        let x = run(name, "", mesh, &handles, &targets);
         let worst = handles
             .constrained()
             .zip(targets.positions())
@@ -94,12 +83,13 @@ fn handle_constraints_are_met() {
 
 #[test]
 fn rebinding_mid_edit_keeps_the_current_shape() {
-    let (mesh, handles, fixed, handle) = bar();
+    let bar = bar();
+    let (mesh, handles, fixed, handle) = (&bar.mesh, bar.handles(), &bar.fixed, &bar.handle);
     let lift = AffineTransform::translation([0.0, 5.0, 0.0]);
-    let targets = targets_by(&mesh, &handles, |v, p| if handle.contains(&v) { lift.apply(p) } else { p });
+    let targets = bar.handle_moved_by(&handles, &lift);
     for name in REFERENCE {
         let mut m = create(name, &toml::Table::new()).unwrap();
-        m.precompute(&mesh).unwrap();
+        m.precompute(mesh).unwrap();
         m.bind_handles(&handles).unwrap();
         m.solve(&targets, &mut NoObserver).unwrap();
         let before = m.positions();
@@ -130,12 +120,13 @@ fn rebinding_mid_edit_keeps_the_current_shape() {
 
 #[test]
 fn results_are_deterministic() {
-    let (mesh, handles, _, handle) = bar();
+    let bar = bar();
+    let (mesh, handles) = (&bar.mesh, bar.handles());
     let twist = AffineTransform::rotation_about([0.0, 0.0, 1.0], 2.0, [0.0, 0.0, 0.0]);
-    let targets = targets_by(&mesh, &handles, |v, p| if handle.contains(&v) { twist.apply(p) } else { p });
+    let targets = bar.handle_moved_by(&handles, &twist);
     for name in REFERENCE {
-        let a = run(name, "max_iterations = 20", &mesh, &handles, &targets);
-        let b = run(name, "max_iterations = 20", &mesh, &handles, &targets);
+        let a = run(name, "max_iterations = 20", mesh, &handles, &targets);
+        let b = run(name, "max_iterations = 20", mesh, &handles, &targets);
         assert!(a == b, "{name}: two runs differ");
     }
 }
@@ -167,12 +158,13 @@ fn unknown_methods_parameters_and_phase_order_are_errors() {
     assert!(e.contains("max_iteratons"), "{e}");
     let e = create("laplacian", &params("omega = -1.0")).err().unwrap().to_string();
     assert!(e.contains("omega"), "{e}");
-    let (mesh, handles, _, _) = bar();
+    let bar = bar();
+    let (mesh, handles) = (&bar.mesh, bar.handles());
     for name in REFERENCE {
         let mut m = create(name, &toml::Table::new()).unwrap();
         assert!(matches!(m.bind_handles(&handles), Err(MethodError::Phase { .. })));
-        m.precompute(&mesh).unwrap();
-        let targets = targets_by(&mesh, &handles, |_, p| p);
+        m.precompute(mesh).unwrap();
+        let targets = bar.rest_targets(&handles);
         assert!(matches!(m.solve(&targets, &mut NoObserver), Err(MethodError::Phase { .. })));
         let other = HandleSet::new(vec![HandleRegion { name: "a".into(), vertices: vec![0] }], 5).unwrap();
         assert!(m.bind_handles(&other).is_err(), "{name}: handle set for another mesh accepted");
@@ -187,16 +179,15 @@ fn unknown_methods_parameters_and_phase_order_are_errors() {
 /// accelerated solve needs far fewer iterations than the plain one to the same tolerance.
 #[test]
 fn anderson_arap_reaches_the_plain_fixed_point_in_fewer_iterations() {
-    let (mesh, handles, _, handle) = bar();
-    let edit: AffineTransform = generate(ShapeKind::Bar, 1500).unwrap().transform;
-    let is_handle = |v: u32| handle.binary_search(&v).is_ok();
-    let targets = targets_by(&mesh, &handles, |v, p| if is_handle(v) { edit.apply(p) } else { p });
+    let bar = bar();
+    let (mesh, handles) = (&bar.mesh, bar.handles());
+    let targets = bar.handle_moved_by(&handles, &bar.edit);
     let run = |acceleration: &str, iterations: usize, tolerance: f64| {
         let text = format!(
             "max_iterations = {iterations}\ntolerance = {tolerance:e}\nacceleration = \"{acceleration}\""
         );
         let mut arap = create("arap", &params(&text)).unwrap();
-        arap.precompute(&mesh).unwrap();
+        arap.precompute(mesh).unwrap();
         arap.bind_handles(&handles).unwrap();
         let summary = arap.solve(&targets, &mut NoObserver).unwrap();
         (summary, arap.positions())

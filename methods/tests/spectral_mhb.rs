@@ -1,31 +1,23 @@
 //! `spectral_mhb` against its paper: with a full basis the reduced system reproduces the unreduced
 //! eq 14; the rest shape and rigid translations are reproduced exactly; clear errors and phase timings.
 
+mod fixtures;
+
 use faer::Mat;
-use meshes::shapes::{generate, ShapeKind};
-use meshes::{AffineTransform, TriMesh, VertexStatus};
+use meshes::{AffineTransform, TriMesh};
 use methods::operators::{cotan_laplacian, lumped_mass, MassKind};
 use methods::spectral_mhb::{SpectralMhb, SpectralMhbParams};
-use methods::{DeformationMethod, HandleRegion, HandleSet, HandleTargets, NoObserver};
+use methods::{DeformationMethod, HandleSet, HandleTargets, NoObserver};
 
 fn params(text: &str) -> SpectralMhbParams {
     toml::Value::Table(text.parse().unwrap()).try_into().unwrap()
 }
 
-/// A procedural bar with its fixed and handle regions.
+/// The fixture's bar with its fixed and handle regions, and the handle region.
 fn bar(vertices: usize) -> (TriMesh, HandleSet, Vec<u32>) {
-    let shape = generate(ShapeKind::Bar, vertices).unwrap();
-    let fixed = meshes::edit::vertices_with_status(&shape.selection, VertexStatus::Fixed);
-    let handle = meshes::edit::vertices_with_status(&shape.selection, VertexStatus::Handle);
-    let handles = HandleSet::new(
-        vec![
-            HandleRegion { name: "fixed".into(), vertices: fixed },
-            HandleRegion { name: "handle".into(), vertices: handle.clone() },
-        ],
-        shape.mesh.n_vertices(),
-    )
-    .unwrap();
-    (shape.mesh, handles, handle)
+    let bar = fixtures::bar(vertices);
+    let handles = bar.handles();
+    (bar.mesh, handles, bar.handle)
 }
 
 fn targets(mesh: &TriMesh, handles: &HandleSet, moved: &[u32], t: &AffineTransform) -> HandleTargets {

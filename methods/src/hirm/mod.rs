@@ -417,6 +417,7 @@ impl DeformationMethod for Hirm {
         let (Some(rest), Some(bound)) = (&self.rest, &self.bound) else {
             return Err(MethodError::Phase { method: "hirm", phase: "solve", missing: "bind_handles" });
         };
+        targets.check_for(&bound.handles)?;
         let (model, system) = (&bound.independent.model, &bound.independent.system);
         let t0 = Instant::now();
         // omega^2 W^T Phi^T H of eq 27, once per solve.

@@ -269,6 +269,7 @@ impl DeformationMethod for Isolines {
         let (Some(rest), Some(bound)) = (&self.rest, &mut self.bound) else {
             return Err(MethodError::Phase { method: name, phase: "solve", missing: "bind_handles" });
         };
+        targets.check_for(&bound.handles)?;
         let t0 = Instant::now();
         let constraint_rhs = bound.system.constraint_rhs(&bound.model, &bound.handles, targets);
         let mut probes = bound.model.probe_positions(self.reduced.as_ref());

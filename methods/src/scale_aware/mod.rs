@@ -380,9 +380,10 @@ impl DeformationMethod for ScaleAware {
         targets: &HandleTargets,
         observer: &mut dyn IterationObserver,
     ) -> Result<SolveSummary, MethodError> {
-        if self.bound.is_none() {
+        let Some(bound) = &self.bound else {
             return Err(MethodError::Phase { method: self.name, phase: "solve", missing: "bind_handles" });
-        }
+        };
+        targets.check_for(&bound.handles)?;
         self.timings = SolveTimings::default();
         let diagonal = self.rest.as_ref().expect("bound implies precomputed").bbox_diagonal;
 

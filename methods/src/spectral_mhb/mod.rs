@@ -124,6 +124,8 @@ enum ReducedSystem {
 }
 
 struct Bound {
+    /// The bound set; a solve's targets must be made for it.
+    handles: HandleSet,
     constrained: Vec<u32>,
     /// `H_C`: the rows of `H` at the constrained vertices (`n' x m`).
     basis_rows: Mat<f64>,
@@ -339,7 +341,7 @@ impl DeformationMethod for SpectralMhb {
                 ReducedSystem::Lagrange { lu: kkt.partial_piv_lu() }
             }
         };
-        self.bound = Some(Bound { constrained, basis_rows, system });
+        self.bound = Some(Bound { handles: handles.clone(), constrained, basis_rows, system });
         self.set_timing(crate::keys::phase::BIND_REDUCED_SYSTEM, start.elapsed().as_secs_f64());
         Ok(())
     }
@@ -356,6 +358,7 @@ impl DeformationMethod for SpectralMhb {
                 missing: "bind_handles",
             });
         };
+        targets.check_for(&bound.handles)?;
         let start = Instant::now();
         let m = self.basis.ncols();
         let nc = bound.constrained.len();
