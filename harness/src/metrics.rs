@@ -2,7 +2,7 @@
 //! the CSV/JSON writers, the printed table, `index.html`, the plots and the regression gate all read.
 //! A new measure is one [`Metric`] variant, one [`MetricSpec`] row and its function.
 //!
-//! The angle errors are the scale-aware paper's (Liu et al. 2010, sec. 5.1); they are blind to
+//! The angle errors are the scale-aware paper's (Liu et al. 2014, sec. 5.1); they are blind to
 //! uniform scaling and to folds, which the area, length, volume and fold measures see.
 
 use std::fmt;

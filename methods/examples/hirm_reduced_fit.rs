@@ -1,5 +1,5 @@
 //! `[MIN_FIELDS=n] [ISOLINES=n] hirm_reduced_fit REST TARGET`: how near HIRM's reduced space
-//! (`X = W R`, eq 4–8, built on the rest mesh REST) comes to a target shape TARGET (same vertices,
+//! (`X = W R`, eq 4-8, built on the rest mesh REST) comes to a target shape TARGET (same vertices,
 //! e.g. the `isolines` result of the same edit): RMS and largest vertex distance of the best
 //! least-squares fit, in bounding-box diagonals. Issue 16's diagnosis of where HIRM cannot follow.
 use methods::DeformationMethod;

@@ -4,8 +4,8 @@
 //! with cotangent weights `w_ij = (cot a_ij + cot b_ij) / 2` (libigl's `cotmatrix` entries; see
 //! "Weights" below for the choice of triangulation), handle
 //! vertices as hard constraints, alternating
-//! - local step: `R_i` = closest rotation to `sum_j w_ij (x_i - x_j)(p_i - p_j)^T` (SA07 eq 5–6);
-//! - global step: `-L X = b`, `b_i = sum_j w_ij / 2 (R_i + R_j)(p_i - p_j)` (SA07 eq 8–9), constrained
+//! - local step: `R_i` = closest rotation to `sum_j w_ij (x_i - x_j)(p_i - p_j)^T` (SA07 eq 5-6);
+//! - global step: `-L X = b`, `b_i = sum_j w_ij / 2 (R_i + R_j)(p_i - p_j)` (SA07 eq 8-9), constrained
 //!   rows eliminated.
 //!
 //! Weights (`weights`, [`LaplacianWeights`]; default `intrinsic_delaunay`). The energy's spokes are

@@ -35,7 +35,7 @@ pub mod phase {
     pub const RT2_INVERSE_MHT: &str = "rt2_inverse_mht";
     pub const RT2_DETAILS: &str = "rt2_details";
 
-    // scale_aware (Liu et al. 2010).
+    // scale_aware (Liu et al. 2014).
     pub const INITIALIZATION_LAPLACIAN: &str = "initialization_laplacian";
     pub const STEP_ONE_NORMALS: &str = "step_one_normals";
     pub const STEP_TWO_ASSEMBLY: &str = "step_two_assembly";

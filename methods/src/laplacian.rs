@@ -1,7 +1,7 @@
 //! `laplacian`: unreduced iterative Laplacian editing, the framework that Au et al. 2007 (section 3,
-//! eq 1–3) and HIRM (section 4.4, eq 10) reduce.
+//! eq 1-3) and HIRM (section 4.4, eq 10) reduce.
 //!
-//! Minimize `|L X - delta(X)|^2 + omega^2 |Phi X - H|^2` (eq 1–2) by the inexact Gauss–Newton update
+//! Minimize `|L X - delta(X)|^2 + omega^2 |Phi X - H|^2` (eq 1-2) by the inexact Gauss–Newton update
 //! `X^{t+1} = (A^T A)^{-1} A^T b(X^t)` (eq 3), `A = [L; omega Phi]`, `A^T A = L^T L + omega^2 Phi^T Phi`
 //! factored once per handle set.
 //!

@@ -1,5 +1,5 @@
 //! Rotation-invariant Laplacian coordinates `delta(X)` (Lipman et al. 2005), the nonlinear right-hand
-//! side of iterative Laplacian editing (Au et al. 2007, eq 1–3): the Laplacian coordinates of a base
+//! side of iterative Laplacian editing (Au et al. 2007, eq 1-3): the Laplacian coordinates of a base
 //! shape are stored in a local frame per vertex (area-weighted vertex normal `n_i`; tangent `t_i` = the
 //! edge to the lowest-index neighbour projected onto the tangent plane; `b_i = n_i x t_i`) and
 //! re-expressed in the frame of the current surface. The base shape is a fixed point.

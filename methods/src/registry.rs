@@ -63,7 +63,7 @@ pub const METHODS: &[MethodEntry] = &[
     },
     MethodEntry {
         name: SCALE_AWARE,
-        summary: "scale-aware shape manipulation: triangle and edge angles, normals on the Gauss map, then G(Theta, N) V = 0 (Liu, Wang, Liu & Liu)",
+        summary: "scale-aware shape manipulation: triangle and edge angles, normals on the Gauss map, then G(Theta, N) V = 0 (Liu, Wang, Liu & Liu 2014)",
         create: |p| Ok(Box::new(ScaleAware::new(SCALE_AWARE, parse(SCALE_AWARE, p)?)?)),
         iterative: true,
     },

@@ -5,7 +5,7 @@ pub type Mat3 = [[f64; 3]; 3];
 
 /// The rotation `R` (det = +1) maximizing `tr(R^T m)`, i.e. the rotational polar factor of `m`
 /// (Umeyama / Kabsch). For ARAP with `m = sum_j w_ij e'_ij e_ij^T` (current edge times rest edge)
-/// it minimizes `sum_j w_ij |e'_ij - R e_ij|^2` (Sorkine & Alexa 2007, eq 5–6).
+/// it minimizes `sum_j w_ij |e'_ij - R e_ij|^2` (Sorkine & Alexa 2007, eq 5-6).
 ///
 /// Computed as `U V^T` from the SVD `m = U S V^T`, with `V` from a Jacobi eigendecomposition of
 /// `m^T m` and `u_k = m v_k / s_k`; rank-deficient inputs complete `U` by cross products (planar

@@ -1,4 +1,4 @@
-//! Properties of `hirm` (Wu et al. 2015): the field selection rule (eq 1–2) on a mesh with a known
+//! Properties of `hirm` (Wu et al. 2015): the field selection rule (eq 1-2) on a mesh with a known
 //! spectrum, the handle-independent interpolation (identity transforms reproduce the base shape), the
 //! background precompute (same matrices as a synchronous one), incremental binding (a new handle set
 //! starts from the current shape, which is a fixed point), and clear errors.

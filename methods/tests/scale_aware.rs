@@ -1,4 +1,4 @@
-//! Properties of `scale_aware` (Liu, Wang, Liu & Liu): the rest mesh solves its own scale-aware
+//! Properties of `scale_aware` (Liu, Wang, Liu & Liu 2014): the rest mesh solves its own scale-aware
 //! equations, the equations and the method are invariant to similarities (a scaled and rotated copy
 //! given as constraints is reproduced), step one keeps unit normals and leaves rest normals alone,
 //! the optimal rigidity approximation restores every triangle's rest area before stitching, the

@@ -1,8 +1,8 @@
-//! The handle-independent system of HIRM (Wu et al. 2015, section 4.5, eq 22–25) and the worker
+//! The handle-independent system of HIRM (Wu et al. 2015, section 4.5, eq 22-25) and the worker
 //! thread that recomputes it from the current shape after every edit step.
 //!
 //! On a base shape `X`: the isolines of the (fixed) propagation fields and the interpolation
-//! `W = W(X)` (eq 22), `T_1 = U^^T U^` with `U^ = [L W; mu M]` (eq 23–24), and `W^T L^T W_sigma`,
+//! `W = W(X)` (eq 22), `T_1 = U^^T U^` with `U^ = [L W; mu M]` (eq 23-24), and `W^T L^T W_sigma`,
 //! which gives `T_2 = W^T L^T W_sigma R_sigma(X)` (eq 25) for any isoline rotations `R_sigma`.
 //! Binding a handle set then only adds `(Phi W)^T (Phi W)` (eq 26).
 //!
@@ -67,7 +67,7 @@ impl KeptConstraints {
     }
 }
 
-/// Eq 22–25 on the `#V x 3` base shape `base`, synchronously.
+/// Eq 22-25 on the `#V x 3` base shape `base`, synchronously.
 pub fn handle_independent_model(base: &[[f64; 3]], inputs: &SystemInputs) -> HandleIndependentModel {
     let start = Instant::now();
     let mut model = IsolineModel::new(

@@ -3,16 +3,16 @@
 //!
 //! Section 4.1: propagation fields, the first eigenvectors of the rest mesh's Laplacian with score
 //! `S_i < phi` ([`propagation_fields`]). Sections 4.2–4.3: `n_iso` isolines per field carry 3x4
-//! transforms `r_ij`; `X = W R` interpolates them linearly along each field (eq 4–5) and blends the
-//! fields by the normalized spectral importances `omega_bar_i` (eq 7–8), so `W` does not depend on
+//! transforms `r_ij`; `X = W R` interpolates them linearly along each field (eq 4-5) and blends the
+//! fields by the normalized spectral importances `omega_bar_i` (eq 7-8), so `W` does not depend on
 //! the handles. Section 4.4: iterative Laplacian editing in the reduced domain,
 //! `R = (U^T U)^{-1} [W^T L^T W_sigma R_sigma(X) + omega^2 W^T Phi^T H]` (eq 20), with `R_sigma` the
-//! isoline rotations of eq 17–19 fitted to the sampled crossed triangles only, so per-iteration work
+//! isoline rotations of eq 17-19 fitted to the sampled crossed triangles only, so per-iteration work
 //! does not depend on `#V`. Section 4.5: after each solve a worker thread recomputes the
-//! handle-independent `T_1`, `T_2` (eq 22–25) on the current shape ([`background`]), with the
+//! handle-independent `T_1`, `T_2` (eq 22-25) on the current shape ([`background`]), with the
 //! constraint term of the handle set just solved for; binding a new handle set that keeps those
 //! regions (incremental editing) only adds the rows of its new regions and factors the `4N x 4N`
-//! matrix (eq 26–28).
+//! matrix (eq 26-28).
 //!
 //! The isoline machinery (tracing, two-level interpolation, the reduced matrices) is shared with
 //! [`crate::isolines`]; what differs is where the fields come from, how they are blended
@@ -63,7 +63,7 @@
 //! 5.2). The reduced space is not what fails: the best least-squares fit of `W R` to the `isolines`
 //! result is 2.2e-4 diagonals RMS (1.6e-3 at worst; `examples/hirm_reduced_fit.rs`). The iteration
 //! settles elsewhere because each isoline of a handle-independent field runs across the nose, cheek
-//! and held region at once, so its one fitted rotation (eq 17–19) is an average of them, and the
+//! and held region at once, so its one fitted rotation (eq 17-19) is an average of them, and the
 //! Laplacian coordinates of the nose are not turned with it. Measured levers (folds, E_theta): 20
 //! fields 0.139%, 9.6 deg; 20 isolines per field 0.051%, 10.8 deg at 3–4x `t_h`; 30 isolines
 //! 0.019%, 8.4 deg at 10x `t_h`. None is fold-free; the report marks the case suspect.
@@ -428,7 +428,7 @@ impl DeformationMethod for Hirm {
             Iterations { first: 0, count: self.params.max_iterations, tolerance: self.params.tolerance };
         let factor = self.normal_factor.as_ref();
         let iterate = |reduced: &mut Mat<f64>, iteration: usize| -> Result<f64, MethodError> {
-            // Eq 17–19, then eq 20 (eq 27 with T_2 = W^T L^T W_sigma R_sigma).
+            // Eq 17-19, then eq 20 (eq 27 with T_2 = W^T L^T W_sigma R_sigma).
             let rotations = model.isoline_rotations(&probes, RotationFit::ScaledOrthogonal);
             let mut rhs = &system.laplacian_rhs * &rotations;
             rhs += &constraints;

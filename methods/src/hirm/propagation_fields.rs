@@ -2,7 +2,7 @@
 //!
 //! The fields are the first non-constant eigenvectors of the Laplacian of the rest mesh,
 //! `Q e = lambda D e` with `Q = -L` and the barycentric lumped mass `D` (the manifold harmonics of
-//! [`crate::linalg::spectral`]), selected by the score `S_i = sqrt(lambda_i / lambda_2) < phi` (eq 1–2).
+//! [`crate::linalg::spectral`]), selected by the score `S_i = sqrt(lambda_i / lambda_2) < phi` (eq 1-2).
 //!
 //! Decisions:
 //! - Eigenvectors are `D`-orthonormal, so the spectral coefficients of eq 7 are the manifold
@@ -26,13 +26,13 @@ pub struct PropagationFields {
     pub scores: Vec<f64>,
     /// `#V x n_field`: the selected eigenvectors rescaled to `[0, 1]`.
     pub fields: Mat<f64>,
-    /// `omega_bar_i` (eq 7–8), `n_field` weights summing to 1.
+    /// `omega_bar_i` (eq 7-8), `n_field` weights summing to 1.
     pub weights: Vec<f64>,
     /// Whether more eigenvectors than `max_fields` had scores below the threshold.
     pub capped: bool,
 }
 
-/// Eq 1–2: the number of eigenvectors `e_2, e_3, ...` with `S_i = sqrt(lambda_i / lambda_2) <
+/// Eq 1-2: the number of eigenvectors `e_2, e_3, ...` with `S_i = sqrt(lambda_i / lambda_2) <
 /// threshold`, for `eigenvalues` ascending with the constant mode's `lambda_1 = 0` first. At least
 /// 1 (`S_2 = 1`) when `threshold > 1`. `None` when `lambda_2` is not positive (a disconnected mesh).
 pub fn select_fields(eigenvalues: &[f64], threshold: f64) -> Option<usize> {

@@ -290,7 +290,7 @@ impl IsolineModel {
         out
     }
 
-    /// Au et al. 2007 eq 8–9 with the frame completion of the module docs:
+    /// Au et al. 2007 eq 8-9 with the frame completion of the module docs:
     /// `r^_m = sum_k l_k^2 F_k F_bar_k^T / sum_k l_k^2`; `None` for isolines without samples.
     fn segment_frame_rotations(&self, probes: &[[f64; 3]]) -> Vec<Option<Mat3>> {
         let n_isolines = self.n_isolines();
@@ -318,9 +318,9 @@ impl IsolineModel {
             .collect()
     }
 
-    /// HIRM eq 17–19: `r~_m` is the least-squares map of the centered corners of the base triangles
+    /// HIRM eq 17-19: `r~_m` is the least-squares map of the centered corners of the base triangles
     /// onto the current ones (eq 17), `r^_m = s_m orth(r~_m)` with `s_m = 3 / trace(Sigma)` of the
-    /// SVD `r~_m = U Sigma V^T` (eq 18–19).
+    /// SVD `r~_m = U Sigma V^T` (eq 18-19).
     ///
     /// Decision: each triangle also maps its unit normal, scaled by the RMS distance of its corners
     /// from the centroid, onto the current one. Without it eq 17 is singular for an isoline whose
@@ -405,10 +405,10 @@ impl IsolineModel {
 /// How [`IsolineModel::isoline_rotations`] fits one rotation per isoline to its crossed triangles.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RotationFit {
-    /// Au et al. 2007 eq 8–9: the average of the segment frames' rotations (module docs of
+    /// Au et al. 2007 eq 8-9: the average of the segment frames' rotations (module docs of
     /// [`super`]).
     SegmentFrames,
-    /// HIRM eq 17–19: least-squares map of the triangles' corners, its rotation by SVD, scaled by
+    /// HIRM eq 17-19: least-squares map of the triangles' corners, its rotation by SVD, scaled by
     /// `3 / trace(Sigma)` to cancel the shrinking of linear interpolation.
     ScaledOrthogonal,
 }
@@ -442,7 +442,7 @@ fn inverse3(m: &Mat3) -> Option<Mat3> {
     Some(std::array::from_fn(|i| std::array::from_fn(|j| cof(j, i) / det)))
 }
 
-/// The handle-independent part of eq 10's matrices (HIRM eq 23–25 calls them `T_1` and `T_2`):
+/// The handle-independent part of eq 10's matrices (HIRM eq 23-25 calls them `T_1` and `T_2`):
 /// they depend on the base shape and the isolines only, so HIRM computes them in the background and
 /// a new handle set only adds its constraint term.
 pub struct HandleIndependentSystem {

@@ -6,11 +6,11 @@
 //! the reduced variables. Section 4.2: vertex positions `X = W_x R_x` interpolate the transforms
 //! linearly between neighbouring isolines and blend the handles by their harmonic values
 //! ([`crate::isoline_model::interpolation`]). Section 4.3: Laplacian coordinates `delta = W_delta R_delta` interpolate per
-//! isoline rotations `r^_ij` fitted to the crossed triangles (eq 8–9), so that the iteration of eq 10
+//! isoline rotations `r^_ij` fitted to the crossed triangles (eq 8-9), so that the iteration of eq 10
 //! only touches the `n_tri` sampled crossed triangles:
 //!
 //! `R_x^{t+1} = (U^T U)^{-1} [(W_x^T L^T W_delta) R_delta^t + omega^2 W_x^T Phi^T H]`,
-//! `U^T U = W_x^T L^T L W_x + omega^2 W_x^T Phi^T Phi W_x + beta^2 M^T M` (eq 5–6),
+//! `U^T U = W_x^T L^T L W_x + omega^2 W_x^T Phi^T Phi W_x + beta^2 M^T M` (eq 5-6),
 //!
 //! separately for x, y and z. [`LaplacianCoordinates::Vertices`] is the paper's intermediate model
 //! with vertex interpolation only (eq 6, Table 1's `t_1`): `delta(W_x R_x)` is evaluated on the whole

@@ -1,9 +1,9 @@
 //! Section 4.2, step one: updating the face normals on the Gauss map so that they meet the edge
-//! angles (eq 4), by local/global as-rigid-as-possible iterations on the pyramids `P_v` (eq 7–11).
+//! angles (eq 4), by local/global as-rigid-as-possible iterations on the pyramids `P_v` (eq 7-11).
 //!
-//! The pyramid of vertex `v` has one spoke `O N_f` per face `f` around `v`. Local phase (eq 7–8):
+//! The pyramid of vertex `v` has one spoke `O N_f` per face `f` around `v`. Local phase (eq 7-8):
 //! `R_v` is the rotation closest to `S_v = sum_f w_vf N'_f N_f^T` (current times rest spoke).
-//! Global phase (eq 9–11): every normal becomes the weighted mean of its three rotated rest
+//! Global phase (eq 9-11): every normal becomes the weighted mean of its three rotated rest
 //! normals, `N'_f = sum_{v in f} w_vf R_v N_f / sum_{v in f} w_vf`, normalized to the sphere.
 //!
 //! Decisions the paper leaves open:
@@ -106,7 +106,7 @@ impl NormalPyramids {
         let mut update = NormalUpdate { iterations: 0, last_change: 0.0 };
         let parallel = self.triangles.len() >= PARALLEL_MIN_FACES;
         for iteration in 0..max_iterations {
-            // Local phase (eq 7–8).
+            // Local phase (eq 7-8).
             let local = |(v, (r, frame)): (usize, (&mut Mat3, &mut Mat3))| {
                 let mut s = [[0.0; 3]; 3];
                 for idx in self.offsets[v]..self.offsets[v + 1] {
@@ -125,7 +125,7 @@ impl NormalPyramids {
             } else {
                 rotations.iter_mut().zip(frames.iter_mut()).enumerate().for_each(local);
             }
-            // Global phase (eq 9–11).
+            // Global phase (eq 9-11).
             let rotations: &[Mat3] = rotations;
             let global = |(f, normal): (usize, &mut [f64; 3])| -> f64 {
                 let rest = self.rest_normals[f];

@@ -1,15 +1,18 @@
-//! `scale_aware`: scale-aware shape manipulation (Liu, Wang, Liu & Liu), and its optimal rigidity
+//! `scale_aware`: scale-aware shape manipulation (Liu, Wang, Liu & Liu 2014), and its optimal rigidity
 //! approximation `scale_aware_ora`.
+//!
+//! The year: the paper's header says 2010 and a footnote 2013, both journal template text (it cites
+//! work of 2014); its DOI, 10.1631/jzus.C1400122, is J. Zhejiang Univ.-Sci. C of 2014.
 //!
 //! Section 3: a mesh is represented by its scale-invariant measures `Omega` — triangle angles and
 //! edge angles ([`scale_invariant_measures`]) — which determine it up to a similarity. With the
-//! face normals `N` known, every corner gives the linear equation `e_{i+1} = l_i R_i e_i` (eq 1–2),
+//! face normals `N` known, every corner gives the linear equation `e_{i+1} = l_i R_i e_i` (eq 1-2),
 //! all corners together the scale-aware equations `G(Theta, N) V = 0` (eq 3,
 //! [`scale_aware_equations`]); the edge angles constrain the normals (eq 4).
 //!
 //! Section 4, Algorithm 1: from an initial guess, alternate
 //! - step one ([`gauss_map`]): the normals of the current shape are moved on the Gauss map towards
-//!   the rest edge angles by local/global ARAP iterations on the normal pyramids (eq 7–11);
+//!   the rest edge angles by local/global ARAP iterations on the normal pyramids (eq 7-11);
 //! - step two: with the normals fixed, `min |G V|^2 + lambda sum_{j in C} |v_j - v_j*|^2` (eq 12,
 //!   `lambda = 100`), i.e. `(G^T G + lambda C) V = lambda C V*`, a `3#V x 3#V` sparse system whose
 //!   values change with the normals: the symbolic factorization is computed once in `precompute`,
@@ -18,7 +21,7 @@
 //! Section 5.2: the initial guess is linear Laplacian editing (Sorkine et al. 2004), here iteration
 //! 0 of [`crate::laplacian`] from the current shape. Section 5.3 ([`optimal_rigidity`]):
 //! `scale_aware_ora` rescales every triangle of the converged result to its rest area and stitches
-//! them (eq 13–15).
+//! them (eq 13-15).
 //!
 //! Decisions the paper leaves open (tested in `methods/tests/scale_aware.rs`):
 //! - Iterations reported to the observer: iteration 0 is the initialization, 1.. are the outer
@@ -282,7 +285,7 @@ impl ScaleAware {
         }
     }
 
-    /// Section 5.3: rescale every triangle to its rest area and stitch (eq 13–15).
+    /// Section 5.3: rescale every triangle to its rest area and stitch (eq 13-15).
     fn approximate_rigidity(&mut self, targets: &HandleTargets) -> Result<(), MethodError> {
         let rest = self.rest.as_ref().expect("precomputed");
         let bound = self.bound.as_mut().expect("bound");

@@ -1,5 +1,5 @@
 //! Section 5.3: the optimal rigidity approximation (ORA). Every triangle of the scale-aware result
-//! is scaled about its centroid back to its rest area (eq 13–14), and the scaled triangles are
+//! is scaled about its centroid back to its rest area (eq 13-14), and the scaled triangles are
 //! stitched into one mesh by least squares on their edge vectors (eq 15, Igarashi et al. 2005).
 //!
 //! Decisions the paper leaves open:
@@ -19,7 +19,7 @@ use meshes::vector::{add, scale, sub};
 
 use crate::linalg::sparse_cholesky::{SolverError, SparseCholesky};
 
-/// Eq 13–14: each triangle of `#V x 3` `positions` scaled about its centroid by
+/// Eq 13-14: each triangle of `#V x 3` `positions` scaled about its centroid by
 /// `tau_t = sqrt(Area_t / Area'_t)` so that its area equals `rest_areas[t]`; `#F` triangles of
 /// three corners each.
 pub fn rescaled_triangles(

@@ -1,4 +1,4 @@
-//! Section 3.2: the scale-aware equations `G(Theta, N) V = 0` (eq 1–3) and the normal equations of
+//! Section 3.2: the scale-aware equations `G(Theta, N) V = 0` (eq 1-3) and the normal equations of
 //! step two (eq 12), `(G^T G + lambda C) V = lambda C V*`.
 //!
 //! Unknowns are vertex-interleaved, `V = [x_0, y_0, z_0, x_1, ...]` (`3 #V`), because the rotations

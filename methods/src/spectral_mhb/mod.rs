@@ -2,9 +2,9 @@
 //!
 //! Pipeline (the paper's section 1, steps 1–4), with the paper's timing names:
 //! 1. PT1 — manifold harmonics bases `H` (`#V x m`): the `m` smallest eigenpairs of `Q h = lambda D h`
-//!    (eq 5–6; `Q = -L_s`, `D` the barycentric lumped mass `D_ii = sum |t| / 3`), see [`crate::linalg::spectral`].
-//! 2. The smoothed model `p~ = H H^T D p` (inverse MHT of the first `m` coefficients, eq 7–8).
-//! 3. PT2 — the reduced energy `S = H^T A H` of the thin-shell energy (eq 9–13), `A` from
+//!    (eq 5-6; `Q = -L_s`, `D` the barycentric lumped mass `D_ii = sum |t| / 3`), see [`crate::linalg::spectral`].
+//! 2. The smoothed model `p~ = H H^T D p` (inverse MHT of the first `m` coefficients, eq 7-8).
+//! 3. PT2 — the reduced energy `S = H^T A H` of the thin-shell energy (eq 9-13), `A` from
 //!    `L = M^{-1} L_s` (eq 13, `M` the Voronoi areas): `A = -k_s L + k_b L^2`.
 //!    Bind — the reduced constraint system (eq 15); RT1 — solve it for the spectral displacement
 //!    `d~` (`m x 3`); the smoothed model deforms to `p~ + H d~`.
@@ -81,9 +81,9 @@ pub enum DetailTransfer {
 pub struct SpectralMhbParams {
     /// Number of manifold harmonics bases `m` (the paper: 100).
     pub bases: usize,
-    /// Stretching stiffness `k_s` of eq 9–13.
+    /// Stretching stiffness `k_s` of eq 9-13.
     pub stretching: f64,
-    /// Bending stiffness `k_b` of eq 9–13.
+    /// Bending stiffness `k_b` of eq 9-13.
     pub bending: f64,
     pub constraints: ConstraintMode,
     /// Relative weight of the constraints in `penalty` mode (scale-free, see the module docs).
@@ -233,7 +233,7 @@ impl DeformationMethod for SpectralMhb {
         self.basis = pairs.vectors;
         self.set_timing(crate::keys::phase::PT1_MANIFOLD_HARMONICS, start.elapsed().as_secs_f64());
 
-        // The smoothed model (eq 7–8).
+        // The smoothed model (eq 7-8).
         let coefficients =
             crate::linalg::spectral::transform(self.basis.as_ref(), &mhb_mass, to_mat(p).as_ref());
         self.smoothed_rest =

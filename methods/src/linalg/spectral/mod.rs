@@ -1,6 +1,6 @@
 //! Manifold harmonics (Rong, Cao & Guo 2008, section 3; Vallet & Lévy 2008): the smallest eigenpairs of
-//! the generalized problem `Q h = lambda D h` (eq 5–6) with `Q = -L_s` the cotangent stiffness matrix
-//! (positive semi-definite) and `D` a lumped mass, and the manifold harmonics transform (eq 7–8).
+//! the generalized problem `Q h = lambda D h` (eq 5-6) with `Q = -L_s` the cotangent stiffness matrix
+//! (positive semi-definite) and `D` a lumped mass, and the manifold harmonics transform (eq 7-8).
 //!
 //! [`smallest_eigenpairs`] solves it by shift-invert block Krylov–Schur (thick-restart block Lanczos)
 //! in the `D` inner product ([`krylov_schur`]); all shift-invert solves reuse one sparse Cholesky
