@@ -30,6 +30,39 @@ use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
 use crate::linalg::row_major::Fused;
 use crate::linalg::row_major::{combine, fma_available, reduce, row, row_mut, MulAdd, Separate};
 
+/// Rows of a supernode's off-diagonal block transposed together by [`scale_supernode`]: a tile of
+/// `TILE x w` values stays in cache while the `w` source columns stream through it.
+const TILE: usize = 64;
+
+/// One supernode of a supernodal factor into the blocked layout: `source` is faer's column-major
+/// `(w + p) x w` block (the `w x w` diagonal block on top of the `p` pattern rows); `block` receives
+/// the packed row-major diagonal block and the row-major `p x w` off-diagonal block, scaled to
+/// `M = L D^-1` with `1 / L_jj^2` on the diagonal. `recip` is scratch.
+fn scale_supernode(source: &[f64], w: usize, p: usize, block: &mut [f64], recip: &mut Vec<f64>) {
+    let nrows = w + p;
+    recip.clear();
+    recip.extend((0..w).map(|j| source[j * nrows + j].recip()));
+    let (diag, below) = block.split_at_mut(w * (w + 1) / 2);
+    for i in 0..w {
+        let row = &mut diag[i * (i + 1) / 2..][..i + 1];
+        for j in 0..i {
+            row[j] = source[j * nrows + i] * recip[j];
+        }
+        row[i] = recip[i] * recip[i];
+    }
+    for r0 in (0..p).step_by(TILE) {
+        let rows = TILE.min(p - r0);
+        let tile = &mut below[r0 * w..(r0 + rows) * w];
+        for j in 0..w {
+            let column = &source[j * nrows + w + r0..][..rows];
+            let r = recip[j];
+            for (k, &v) in column.iter().enumerate() {
+                tile[k * w + j] = v * r;
+            }
+        }
+    }
+}
+
 /// Layout of `L` plus the gather map from faer's value array.
 #[derive(Debug, Default)]
 pub(super) struct BlockedFactor {
@@ -43,8 +76,10 @@ pub(super) struct BlockedFactor {
     /// Start of each supernode's values in `values`, then the total.
     value_ptr: Vec<usize>,
     values: Vec<f64>,
-    /// `values[t] = faer_values[source[t]]`.
+    /// `values[t] = faer_values[source[t]]` (simplicial factors; empty for supernodal ones).
     source: Vec<usize>,
+    /// Supernodal factors: where each supernode's column-major block starts in faer's values.
+    faer_base: Vec<usize>,
     /// Use the AVX2 + FMA kernels.
     fused: bool,
 }
@@ -61,24 +96,18 @@ impl BlockedFactor {
                 f.first_col.reserve(ns + 1);
                 f.value_ptr.push(0);
                 f.pattern_ptr.push(0);
-                f.source.reserve(sym.len_val());
+                f.faer_base.reserve(ns);
+                let mut len = 0;
                 for s in 0..ns {
                     let c0 = sym.supernode_begin()[s];
                     let w = sym.supernode_end()[s] - c0;
                     let pattern = sym.supernode(s).pattern();
-                    let nrows = w + pattern.len();
-                    let base = val_ptr[s];
                     f.first_col.push(to_u32(c0));
                     f.pattern.extend(pattern.iter().map(|&i| to_u32(i)));
-                    // Column-major `nrows x w` block in faer: entry (i, j) at base + j * nrows + i.
-                    for i in 0..w {
-                        f.source.extend((0..=i).map(|j| base + j * nrows + i));
-                    }
-                    for r in 0..pattern.len() {
-                        f.source.extend((0..w).map(|j| base + j * nrows + w + r));
-                    }
+                    f.faer_base.push(val_ptr[s]);
+                    len += w * (w + 1) / 2 + pattern.len() * w;
                     f.pattern_ptr.push(f.pattern.len());
-                    f.value_ptr.push(f.source.len());
+                    f.value_ptr.push(len);
                 }
                 f.first_col.push(to_u32(f.n));
             }
@@ -127,21 +156,31 @@ impl BlockedFactor {
                 f.first_col.push(to_u32(n));
             }
         }
-        f.values = vec![0.0; f.source.len()];
+        f.values = vec![0.0; *f.value_ptr.last().expect("value_ptr starts with 0")];
         f
     }
 
     /// Take the numeric values of faer's factor (laid out as described by the symbolic structure
     /// this was built from), in the scaled form described in the module documentation.
     pub(super) fn set_values(&mut self, faer_values: &[f64]) {
-        for (v, &t) in self.values.iter_mut().zip(&self.source) {
-            *v = faer_values[t];
+        if self.faer_base.is_empty() {
+            for (v, &t) in self.values.iter_mut().zip(&self.source) {
+                *v = faer_values[t];
+            }
         }
         // M = L D^-1 below the diagonal, 1 / L_jj^2 on it.
         let mut recip = Vec::new();
         for s in 0..self.n_supernodes() {
             let w = (self.first_col[s + 1] - self.first_col[s]) as usize;
             let block = &mut self.values[self.value_ptr[s]..self.value_ptr[s + 1]];
+            if let Some(&base) = self.faer_base.get(s) {
+                // Faer's column-major `nrows x w` block, entry (i, j) at base + j * nrows + i:
+                // transposed and scaled in one pass (the same products as the gather below).
+                let p = self.pattern_ptr[s + 1] - self.pattern_ptr[s];
+                let source = &faer_values[base..base + (w + p) * w];
+                scale_supernode(source, w, p, block, &mut recip);
+                continue;
+            }
             let (diag, below) = block.split_at_mut(w * (w + 1) / 2);
             recip.clear();
             recip.extend((0..w).map(|j| diag[j * (j + 1) / 2 + j].recip()));
