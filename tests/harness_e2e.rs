@@ -951,3 +951,61 @@ fn a_collection_runs_one_scenario_per_matching_mesh() {
     );
     assert!(rows.iter().all(|r| r["status"] == "ok"), "{rows:?}");
 }
+
+/// Issue 18: result meshes are GLB by default, OFF or both on request, and a scenario with
+/// `result_meshes = false` writes none unless `--every-mesh` asks.
+#[test]
+fn mesh_format_and_every_mesh_choose_the_result_files() {
+    let scenario = |name: &str, extra: &str| {
+        (
+            format!("{name}.toml"),
+            format!(
+                "name = \"{name}\"\nprocedural = {{ shape = \"bar\", vertices = 600 }}\n\
+                 methods = [\"laplacian\"]\n{extra}"
+            ),
+        )
+    };
+    let configs = configs_with(&[scenario("kept", ""), scenario("sweep", "result_meshes = false\n")]);
+    let work = tempfile::tempdir().unwrap();
+    let files = |args: &[&str]| -> Vec<String> {
+        let reports = work.path().join(args.join("_").replace('-', ""));
+        let mut full = vec![
+            "all",
+            "--quiet",
+            "--configs",
+            configs.path().to_str().unwrap(),
+            "--reports",
+            reports.to_str().unwrap(),
+        ];
+        full.extend_from_slice(args);
+        full.push("--no-check");
+        assert_eq!(run(&full).unwrap(), std::process::ExitCode::SUCCESS, "{args:?}");
+        let mut names: Vec<String> = std::fs::read_dir(reports.join("meshes"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    };
+    assert_eq!(files(&[]), ["kept-laplacian.glb"]);
+    assert_eq!(files(&["--mesh-format", "off"]), ["kept-laplacian.off"]);
+    assert_eq!(
+        files(&["--mesh-format", "both", "--every-mesh"]),
+        ["kept-laplacian.glb", "kept-laplacian.off", "sweep-laplacian.glb", "sweep-laplacian.off"]
+    );
+    // The OFF file holds the full-precision shape, the GLB the same mesh in f32.
+    let dir = work.path().join("meshformat_both_everymesh/meshes");
+    let (off, glb) = (
+        meshes::io::read_mesh(dir.join("kept-laplacian.off")).unwrap(),
+        meshes::io::read_mesh(dir.join("kept-laplacian.glb")).unwrap(),
+    );
+    assert_eq!(off.triangles(), glb.triangles());
+    let worst = off
+        .positions()
+        .iter()
+        .zip(glb.positions())
+        .flat_map(|(a, b)| (0..3).map(move |k| (a[k] - b[k]).abs()))
+        .fold(0.0, f64::max);
+    // f32 rounding: half a unit in the last place, about 6e-8 of the coordinates' size.
+    assert!(worst <= 1e-7 * off.bbox_diagonal(), "GLB positions {worst:e} from the OFF ones");
+}
