@@ -78,20 +78,6 @@ pub(crate) fn reduced_step(
     Ok(step)
 }
 
-#[cfg(test)]
-mod divergence_tests {
-    use super::*;
-
-    #[test]
-    fn a_runaway_step_after_the_first_iteration_is_a_divergence_error() {
-        assert!(check_divergence("hirm", 0, 5.0).is_ok(), "the first iteration moves to the targets");
-        assert!(check_divergence("hirm", 7, 0.5).is_ok());
-        let e = check_divergence("hirm", 7, 29.0).unwrap_err();
-        assert!(matches!(e, MethodError::Diverged { method: "hirm", iteration: 7, .. }));
-        assert!(e.to_string().contains("`hirm` diverged: iteration 7"), "{e}");
-    }
-}
-
 /// `W_x R_x` for every vertex (`#V x 3`), or the first non-finite vertex as an error.
 pub(crate) fn checked_positions(
     method: &'static str,
@@ -114,4 +100,18 @@ pub(crate) fn segment_frame(p: [[f64; 3]; 3], q0: [f64; 3], q1: [f64; 3]) -> [[f
     // Remove any normal component rounding left, so the frame stays orthonormal.
     let along = normalize_or_zero(sub(along, scale(normal, dot(along, normal))));
     [normal, along, cross(normal, along)]
+}
+
+#[cfg(test)]
+mod divergence_tests {
+    use super::*;
+
+    #[test]
+    fn a_runaway_step_after_the_first_iteration_is_a_divergence_error() {
+        assert!(check_divergence("hirm", 0, 5.0).is_ok(), "the first iteration moves to the targets");
+        assert!(check_divergence("hirm", 7, 0.5).is_ok());
+        let e = check_divergence("hirm", 7, 29.0).unwrap_err();
+        assert!(matches!(e, MethodError::Diverged { method: "hirm", iteration: 7, .. }));
+        assert!(e.to_string().contains("`hirm` diverged: iteration 7"), "{e}");
+    }
 }
