@@ -75,7 +75,7 @@ pub enum RunPhase {
 }
 
 impl RunPhase {
-    /// Every phase, in run order.
+    /// Every phase, in run order (each at the index of its discriminant).
     pub const ALL: [RunPhase; 8] = [
         RunPhase::Methods,
         RunPhase::TraceQuality,
@@ -134,12 +134,11 @@ pub fn publish(
     publish: &PublishOptions,
     gate: GateRequest,
 ) -> Result<Outcome, HarnessError> {
-    let mut phases: Vec<(RunPhase, f64)> = vec![
-        (RunPhase::Methods, run.results.iter().map(method_seconds).sum()),
-        (RunPhase::TraceQuality, run.results.iter().map(|r| r.overhead.trace_quality_s).sum()),
-        (RunPhase::Evaluation, run.results.iter().map(|r| r.overhead.evaluation_s).sum()),
-    ];
-    let mut timed = |phase: RunPhase, start: Instant| phases.push((phase, start.elapsed().as_secs_f64()));
+    let mut seconds = [0.0; RunPhase::ALL.len()];
+    seconds[RunPhase::Methods as usize] = run.results.iter().map(method_seconds).sum();
+    seconds[RunPhase::TraceQuality as usize] = run.results.iter().map(|r| r.overhead.trace_quality_s).sum();
+    seconds[RunPhase::Evaluation as usize] = run.results.iter().map(|r| r.overhead.evaluation_s).sum();
+    let mut timed = |phase: RunPhase, start: Instant| seconds[phase as usize] = start.elapsed().as_secs_f64();
 
     let start = Instant::now();
     if let Some(python) = &publish.peer_python {
@@ -181,7 +180,7 @@ pub fn publish(
         gate: outcome,
         suspect: run.results.iter().filter(|r| r.status.is_suspect()).count(),
         failed: run.results.iter().filter(|r| r.status.is_failed()).count(),
-        phases,
+        phases: RunPhase::ALL.into_iter().zip(seconds).collect(),
     })
 }
 
@@ -222,4 +221,20 @@ pub fn write_baseline(reports_dir: &Path, baseline: Option<&Path>) -> Result<(Pa
 fn method_seconds(r: &CaseResult) -> f64 {
     let bind: f64 = r.steps.iter().map(|s| s.bind_s).sum();
     [r.precompute_s, bind, r.solve_s].into_iter().filter(|t| t.is_finite()).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_phase_sits_at_its_own_index_with_its_own_label() {
+        for (i, phase) in RunPhase::ALL.into_iter().enumerate() {
+            assert_eq!(phase as usize, i, "{phase:?}");
+        }
+        let mut labels: Vec<&str> = RunPhase::ALL.iter().map(|p| p.label()).collect();
+        labels.sort_unstable();
+        labels.dedup();
+        assert_eq!(labels.len(), RunPhase::ALL.len(), "labels repeat");
+    }
 }
