@@ -313,7 +313,7 @@ fn publish_and_print(
     for note in &run.notes {
         eprintln!("note: {note}");
     }
-    let outcome = pipeline::publish(options, &mut run, publish, gate).context("writing reports")?;
+    let outcome = pipeline::publish(options, &mut run, publish, gate).context("publishing the run")?;
     println!("data: {}", run.data_source);
     print_table(&run.results);
     print_phases(&outcome);
@@ -342,7 +342,7 @@ fn print_phases(outcome: &Outcome) {
     for (phase, seconds) in &outcome.phases {
         println!("  {:<38} {seconds:>8.2}", phase.label());
     }
-    println!("  {:<38} {total:>8.2}", "total");
+    println!("  {:<38} {total:>8.2}", "sum (loading the inputs is not timed)");
 }
 
 /// The results table on stdout: one row per case, the timings, every metric of the table, the status.

@@ -142,7 +142,8 @@ pub fn publish(
 
     let start = Instant::now();
     if let Some(python) = &publish.peer_python {
-        let answers = peers::self_intersections(python, &run.results, &run.scenarios)?;
+        let answers = peers::self_intersections(python, &run.results, &run.scenarios)
+            .map_err(|e| HarnessError::Report(format!("self-intersection check (open3d): {e}")))?;
         for (r, answer) in run.results.iter_mut().zip(answers) {
             r.self_intersecting = answer;
         }

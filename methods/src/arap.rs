@@ -144,7 +144,10 @@ impl Arap {
         {
             return Err(MethodError::Parameters {
                 method: "arap",
-                message: "max_iterations must be >= 1, tolerance >= 0 and anderson_depth <= 16".into(),
+                message: format!(
+                    "max_iterations must be >= 1, tolerance >= 0 and anderson_depth <= {}",
+                    crate::linalg::anderson::MAX_DEPTH
+                ),
             });
         }
         Ok(Self {

@@ -11,9 +11,8 @@ use crate::method::DeformationMethod;
 use crate::scale_aware::ScaleAware;
 use crate::spectral_mhb::SpectralMhb;
 
-/// One registered method.
-/// The registered method names, the one place they are spelled (entries below, the harness's
-/// reports and tables use these).
+// The registered method names, the one place they are spelled (the entries below, the harness's
+// reports and tables use these).
 pub const LAPLACIAN: &str = "laplacian";
 pub const ARAP: &str = "arap";
 pub const HIRM: &str = "hirm";
@@ -24,6 +23,7 @@ pub const ISOLINES: &str = "isolines";
 pub const ISOLINES_10: &str = "isolines_10";
 pub const ISOLINES_T1: &str = "isolines_t1";
 
+/// One registered method.
 pub struct MethodEntry {
     /// Name used in configs, on the command line and in reports.
     pub name: &'static str,

@@ -1,6 +1,7 @@
-//! Anderson acceleration (type II; Walker & Ni 2011) of the fixed-point iteration `x <- T(x)` of
-//! Algorithm 1, as Peng et al. 2018 use it for local/global geometry solvers. It changes the path,
-//! not the fixed points: a converged `x` has `T(x) = x` either way.
+//! Anderson acceleration (type II; Walker & Ni 2011) of a fixed-point iteration `x <- T(x)`, as
+//! Peng et al. 2018 use it for local/global geometry solvers: `arap`'s local/global map and
+//! `scale_aware`'s Algorithm 1. It changes the path, not the fixed points: a converged `x` has
+//! `T(x) = x` either way.
 //!
 //! Safeguard (on by default; [`AndersonAcceleration::with_residual_growth_limit`] for callers with
 //! an energy to test, as `arap`): when the residual `|T(x) - x|` grows, the history is dropped and

@@ -165,9 +165,10 @@ impl SparseCholesky {
     /// Solve `A X = B` in place for the `n x k` right-hand sides `rhs`. Workspace is allocated on the
     /// first call for `k` columns (an `n x 16` block at most) and reused afterwards.
     ///
-    /// Columns are solved together in chunks of up to 16, so several columns cost much less than
-    /// as many single solves. From 16 columns on, two halves of the columns are solved on two rayon
-    /// threads. The result for given inputs is bitwise reproducible (it depends on `k`, not on
+    /// A single column is solved by faer on the factor as it is. Several columns are solved
+    /// together on the blocked copy of the factor (built on the first such solve after a
+    /// factorization), in chunks of up to 16, so they cost much less than as many single solves.
+    /// From 16 columns on, two halves of the columns are solved on two rayon threads. The result for given inputs is bitwise reproducible (it depends on `k`, not on
     /// thread scheduling).
     ///
     /// # Panics

@@ -39,8 +39,8 @@
 //!   step is handled like the first.
 //! - Acceleration. Algorithm 1 converges linearly and slowly: on the survey cactus the largest step
 //!   is still 1e-3 of the diagonal after 50 plain outer iterations (E_phi 0.49 deg, 0.43 after
-//!   300). The outer iteration is therefore Anderson-accelerated ([`crate::linalg::anderson`], depth 5 by default;
-//!   `anderson_depth = 0` is the plain iteration). It does not change the fixed points, and the
+//!   300). The outer iteration is therefore Anderson-accelerated ([`crate::linalg::anderson`],
+//!   depth 5 by default; `anderson_depth = 0` is the plain iteration). It does not change the fixed points, and the
 //!   convergence test uses the fixed-point residual `|T(x) - x|`, which is the plain step.
 //! - Step one's inner loop rarely meets `normal_tolerance` within `normal_iterations`: the smooth
 //!   rotation of the Gauss map that carries the bend is its slowest mode, and the outer iteration
@@ -188,9 +188,11 @@ impl ScaleAware {
         if !valid {
             return Err(MethodError::Parameters {
                 method: name,
-                message: "constraint_weight and initialization_omega must be > 0, max_iterations and \
-                          normal_iterations >= 1, tolerance and normal_tolerance >= 0, anderson_depth <= 16"
-                    .into(),
+                message: format!(
+                    "constraint_weight and initialization_omega must be > 0, max_iterations and \
+                     normal_iterations >= 1, tolerance and normal_tolerance >= 0, anderson_depth <= {}",
+                    anderson::MAX_DEPTH
+                ),
             });
         }
         let initialization = LaplacianEditing::new(LaplacianParams {

@@ -63,7 +63,8 @@ fn scale_supernode(source: &[f64], w: usize, p: usize, block: &mut [f64], recip:
     }
 }
 
-/// Layout of `L` plus the gather map from faer's value array.
+/// Layout of `L` plus where its values come from in faer's value array (a gather map for a
+/// simplicial factor, block offsets for a supernodal one).
 #[derive(Debug, Default)]
 pub(super) struct BlockedFactor {
     n: usize,
