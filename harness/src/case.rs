@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::metrics::{angle_errors, largest_displacement, Evaluation, Metric, Quality, RestGeometry};
 use crate::scenario::LoadedScenario;
-use crate::verdict::{Status, VerdictRules};
+use crate::verdict::{Status, Unfinished, VerdictRules};
 
 /// One iteration as recorded for convergence curves.
 #[derive(Clone, Copy, Debug, Serialize, Deserialize)]
@@ -63,6 +63,10 @@ pub struct StepRecord {
     pub solve_s: f64,
     pub iterations: usize,
     pub converged: bool,
+    /// The last iteration's step over the rest diagonal (what `converged` compared with the
+    /// method's tolerance).
+    #[serde(default = "nan", deserialize_with = "nan_from_null")]
+    pub final_step: f64,
     #[serde(deserialize_with = "nan_from_null")]
     pub median_iteration_ms: f64,
     /// The method's phase timings after this step (e.g. HIRM's `t_h_handle_update`).
@@ -198,6 +202,9 @@ pub fn run_case(
     );
     result.laplacian_weights = laplacian_weights(params);
     let mut recorder = Recorder { scenario, rest, trace: Vec::new(), edit_step: 0, quality_s: 0.0 };
+    let mut unfinished = Vec::new();
+    let cap = params.get("max_iterations").and_then(toml::Value::as_integer).map(|c| c as usize);
+    let tolerance = params.get("tolerance").and_then(toml::Value::as_float);
     let outcome = (|| -> Result<Vec<String>, methods::MethodError> {
         let mut m = methods::registry::create(method, params)?;
         let start = Instant::now();
@@ -223,6 +230,16 @@ pub fn run_case(
             let step_solve_s = t.elapsed().as_secs_f64() - (recorder.quality_s - quality_before);
             solve_s += step_solve_s;
             result.iterations += summary.iterations;
+            if !summary.converged {
+                unfinished.push(Unfinished {
+                    step: i + 1,
+                    steps: scenario.steps.len(),
+                    iterations: summary.iterations,
+                    cap,
+                    last_step: summary.final_step,
+                    tolerance,
+                });
+            }
             result.steps.push(StepRecord {
                 step: i + 1,
                 handles: step.handles.regions().len(),
@@ -231,6 +248,7 @@ pub fn run_case(
                 solve_s: step_solve_s,
                 iterations: summary.iterations,
                 converged: summary.converged,
+                final_step: summary.final_step,
                 median_iteration_ms: median_ms(&recorder.trace[first_iteration..]),
                 phase_timings: m.phase_timings().into_iter().map(|(k, v)| (k.to_string(), v)).collect(),
             });
@@ -281,10 +299,14 @@ pub fn run_case(
     result.trace = recorder.trace;
     result.overhead.trace_quality_s = recorder.quality_s;
     result.status = match outcome {
-        Ok(reasons) => Status::from_reasons(reasons),
+        Ok(reasons) => Status::judge(&unfinished, reasons),
         Err(e) => Status::Failed(e.to_string()),
     };
     result
+}
+
+fn nan() -> f64 {
+    f64::NAN
 }
 
 /// `results.json` writes a missing (NaN) number as `null`; read it back as NaN.

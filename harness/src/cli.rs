@@ -328,6 +328,12 @@ fn publish_and_print(
     if outcome.suspect > 0 {
         println!("{} case(s) suspect (see the status column and the reasons there)", outcome.suspect);
     }
+    if outcome.unfinished > 0 {
+        println!(
+            "{} case(s) unfinished: stopped at their iteration cap, judged on an iterate (see the status column)",
+            outcome.unfinished
+        );
+    }
     if outcome.failed > 0 {
         eprintln!("error: {} case(s) failed (see the status column)", outcome.failed);
         return Ok(ExitCode::from(EXIT_CASE_FAILED));

@@ -118,6 +118,8 @@ pub struct Outcome {
     pub gate: GateOutcome,
     /// Cases whose status is `suspect`.
     pub suspect: usize,
+    /// Cases whose status is `unfinished` (stopped at their iteration cap).
+    pub unfinished: usize,
     /// Cases whose status is `failed`.
     pub failed: usize,
     /// Wall seconds of each phase of the run ([`RunPhase::ALL`] order; a phase that did not run
@@ -180,6 +182,7 @@ pub fn publish(
     Ok(Outcome {
         gate: outcome,
         suspect: run.results.iter().filter(|r| r.status.is_suspect()).count(),
+        unfinished: run.results.iter().filter(|r| r.status.is_unfinished()).count(),
         failed: run.results.iter().filter(|r| r.status.is_failed()).count(),
         phases: RunPhase::ALL.into_iter().zip(seconds).collect(),
     })

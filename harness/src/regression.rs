@@ -2,7 +2,7 @@
 //! for runs on the survey meshes, `reports/baselines/procedural.json` for the procedural look-alikes)
 //! holds the verdict and every gated measure of the metric table ([`crate::metrics::METRICS`]) of
 //! each (scenario, method). [`check`] compares a run against it and names every measure that got
-//! worse beyond its tolerance, every case that turned suspect, failed or produced a non-finite
+//! worse beyond its tolerance, every case that turned suspect or unfinished, failed or produced a non-finite
 //! measure, and every baseline case the run lacks. Improvements pass (and are listed, so the
 //! baseline can be renewed on purpose with `harness baseline`).
 
@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 use crate::case::CaseResult;
 use crate::error::HarnessError;
 use crate::metrics::{Metric, METRICS};
+use crate::verdict::STATUS_KINDS;
 
 /// One (scenario, method) of the baseline.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -24,7 +25,7 @@ pub struct BaselineCase {
     /// `survey` or `procedural look-alike` (the `mesh_source` column): a run of the same case on
     /// other data is not compared.
     pub mesh_source: String,
-    /// `ok` or `suspect` (the verdict without its reasons).
+    /// `ok`, `suspect` or `unfinished` (the verdict without its reasons).
     pub verdict: String,
     /// The gated measures by metric key; a measure without a value (e.g. the volume of an open
     /// mesh) is absent.
@@ -75,8 +76,9 @@ pub fn gated_metrics() -> impl Iterator<Item = Metric> {
 pub enum Finding {
     /// Worse than the baseline beyond the metric's tolerance.
     Worse { scenario: String, method: String, metric: Metric, baseline: f64, current: f64 },
-    /// `ok` in the baseline, suspect now.
-    TurnedSuspect { scenario: String, method: String, status: String },
+    /// A worse status kind than in the baseline (`from`): ok -> suspect or unfinished, suspect ->
+    /// unfinished ([`crate::verdict::STATUS_KINDS`] order); `status` is the run's, with reasons.
+    Turned { scenario: String, method: String, from: String, status: String },
     /// The case did not run to a result.
     Failed { scenario: String, method: String, status: String },
     /// The case ran but a gated metric is NaN or infinite.
@@ -85,14 +87,14 @@ pub enum Finding {
     Missing { scenario: String, method: String },
     /// Better than the baseline beyond the tolerance (not a failure).
     Better { scenario: String, method: String, metric: Metric, baseline: f64, current: f64 },
-    /// Suspect in the baseline, `ok` now (not a failure).
-    NowOk { scenario: String, method: String },
+    /// A better status kind than in the baseline (`from`; not a failure).
+    Improved { scenario: String, method: String, from: String, to: String },
 }
 
 impl Finding {
     /// Whether this finding fails the gate.
     pub fn is_regression(&self) -> bool {
-        !matches!(self, Finding::Better { .. } | Finding::NowOk { .. })
+        !matches!(self, Finding::Better { .. } | Finding::Improved { .. })
     }
 }
 
@@ -105,8 +107,9 @@ impl fmt::Display for Finding {
                 100.0 * (metric.badness(*current) - metric.badness(*baseline))
                     / baseline.abs().max(f64::MIN_POSITIVE)
             ),
-            Finding::TurnedSuspect { scenario, method, status } => {
-                write!(f, "turned suspect: {scenario} / {method} (ok in the baseline): {status}")
+            Finding::Turned { scenario, method, from, status } => {
+                let to = status.split(':').next().unwrap_or(status);
+                write!(f, "turned {to}: {scenario} / {method} ({from} in the baseline): {status}")
             }
             Finding::Failed { scenario, method, status } => write!(f, "failed: {scenario} / {method}: {status}"),
             Finding::NonFinite { scenario, method, metric } => {
@@ -116,8 +119,8 @@ impl fmt::Display for Finding {
             Finding::Better { scenario, method, metric, baseline, current } => {
                 write!(f, "better: {scenario} / {method} / {metric}: {current:.4} against baseline {baseline:.4}")
             }
-            Finding::NowOk { scenario, method } => {
-                write!(f, "now ok: {scenario} / {method} (suspect in the baseline)")
+            Finding::Improved { scenario, method, from, to } => {
+                write!(f, "now {to}: {scenario} / {method} ({from} in the baseline)")
             }
         }
     }
@@ -171,16 +174,16 @@ pub fn check(baseline: &Baseline, results: &[CaseResult]) -> Vec<Finding> {
             continue;
         }
         let reference = baseline.cases.iter().find(|b| b.scenario == r.scenario && b.method == r.method);
-        match reference.map(|b| b.verdict.as_str()) {
-            Some("ok") if r.status.is_suspect() => findings.push(Finding::TurnedSuspect {
-                scenario: scenario.clone(),
-                method: method.clone(),
-                status: r.status.to_string(),
-            }),
-            Some("suspect") if r.status.is_ok() => {
-                findings.push(Finding::NowOk { scenario: scenario.clone(), method: method.clone() })
+        let rank = |kind: &str| STATUS_KINDS.iter().position(|k| *k == kind);
+        if let Some((from, was, now)) =
+            reference.and_then(|b| Some((b.verdict.clone(), rank(&b.verdict)?, rank(r.status.kind())?)))
+        {
+            let (scenario, method) = (scenario.clone(), method.clone());
+            if now > was {
+                findings.push(Finding::Turned { scenario, method, from, status: r.status.to_string() });
+            } else if now < was {
+                findings.push(Finding::Improved { scenario, method, from, to: r.status.kind().to_string() });
             }
-            _ => {}
         }
         for metric in gated_metrics() {
             let Some(current) = r.quality.get(metric) else { continue };
@@ -379,6 +382,28 @@ mod tests {
         assert!(check(&suspect_baseline, &r).is_empty());
         let findings = check(&suspect_baseline, &run());
         assert!(findings.len() == 1 && !findings[0].is_regression(), "{findings:?}");
+    }
+
+    #[test]
+    fn a_case_that_ends_unfinished_fails_the_gate_from_ok_and_from_suspect() {
+        let unfinished = Status::Unfinished(vec!["stopped at the 500-iteration cap".into()]);
+        let mut r = run();
+        r[0].status = unfinished.clone();
+        let findings = check(&baseline(), &r);
+        assert!(findings.len() == 1 && findings[0].is_regression(), "{findings:?}");
+        assert!(
+            findings[0].to_string().starts_with("turned unfinished: bar / arap (ok in the baseline)"),
+            "{}",
+            findings[0]
+        );
+        let mut suspect = run();
+        suspect[0].status = Status::Suspect(vec!["folds".into()]);
+        let findings = check(&baseline_from(&suspect), &r);
+        assert!(findings.len() == 1 && findings[0].is_regression(), "{findings:?}");
+        // Unfinished in the baseline, finished now: listed, passes.
+        let findings = check(&baseline_from(&r), &run());
+        assert!(findings.len() == 1 && !findings[0].is_regression(), "{findings:?}");
+        assert!(findings[0].to_string().starts_with("now ok: bar / arap (unfinished in the baseline)"));
     }
 
     #[test]

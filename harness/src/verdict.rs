@@ -1,9 +1,11 @@
 //! The verdict on a case: `ok`, `suspect: <reasons>` (it finished, but its shape is broken in a way
-//! a measure sees), or `failed: <error>` (no result). The thresholds are data
-//! (`configs/verdicts.toml`), each with the reason for its value written there.
+//! a measure sees), `unfinished: <reasons>` (its iteration stopped at the cap before reaching its
+//! tolerance: the shape is an iterate, not the method's answer; any suspect reasons follow), or
+//! `failed: <error>` (no result). The thresholds are data (`configs/verdicts.toml`), each with the
+//! reason for its value written there.
 //!
-//! A suspect case is still a result: the run's exit code stays 0 for it, and it is drawn and
-//! reported like any other, with its reasons. Not converging is its own column, not a reason.
+//! Suspect and unfinished cases are still results: the run's exit code stays 0 for them, and they
+//! are drawn and reported like any other, with their reasons.
 
 use std::fmt;
 use std::path::Path;
@@ -81,15 +83,53 @@ impl VerdictRules {
     }
 }
 
+/// Why a case's iteration did not finish: one edit step that stopped before its step fell below
+/// the method's tolerance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Unfinished {
+    /// 1-based edit step, and how many the scenario has.
+    pub step: usize,
+    pub steps: usize,
+    /// Iterations the step ran, and the method's `max_iterations` if it has one.
+    pub iterations: usize,
+    pub cap: Option<usize>,
+    /// The last iteration's step over the rest diagonal, and the method's tolerance if it has one.
+    pub last_step: f64,
+    pub tolerance: Option<f64>,
+}
+
+impl fmt::Display for Unfinished {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.steps > 1 {
+            write!(f, "edit step {} of {} ", self.step, self.steps)?;
+        }
+        match self.cap {
+            Some(cap) if self.iterations >= cap => write!(f, "stopped at the {cap}-iteration cap")?,
+            _ => write!(f, "stopped after {} iterations without converging", self.iterations)?,
+        }
+        write!(f, ", last step {:.1e} of the diagonal", self.last_step)?;
+        if let Some(t) = self.tolerance {
+            write!(f, " (tolerance {t:.0e})")?;
+        }
+        Ok(())
+    }
+}
+
 /// The verdict on one case.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Status {
     Ok,
     /// Finished, with these reasons to distrust the shape.
     Suspect(Vec<String>),
+    /// The iteration stopped before its tolerance: the first reason says where (an [`Unfinished`]),
+    /// any further ones are the shape's suspect reasons.
+    Unfinished(Vec<String>),
     /// No result: the method's error.
     Failed(String),
 }
+
+/// Every status kind, from best to worst: the text before `:`, the CSS class, the summary's order.
+pub const STATUS_KINDS: [&str; 4] = ["ok", "suspect", "unfinished", "failed"];
 
 impl Status {
     pub fn is_ok(&self) -> bool {
@@ -100,22 +140,45 @@ impl Status {
         matches!(self, Status::Suspect(_))
     }
 
+    pub fn is_unfinished(&self) -> bool {
+        matches!(self, Status::Unfinished(_))
+    }
+
     pub fn is_failed(&self) -> bool {
         matches!(self, Status::Failed(_))
     }
 
-    /// `ok`, `suspect` or `failed`, without the reasons.
+    /// One of [`STATUS_KINDS`], without the reasons.
     pub fn kind(&self) -> &'static str {
         match self {
-            Status::Ok => "ok",
-            Status::Suspect(_) => "suspect",
-            Status::Failed(_) => "failed",
+            Status::Ok => STATUS_KINDS[0],
+            Status::Suspect(_) => STATUS_KINDS[1],
+            Status::Unfinished(_) => STATUS_KINDS[2],
+            Status::Failed(_) => STATUS_KINDS[3],
+        }
+    }
+
+    /// The reasons of a suspect or unfinished case (empty otherwise).
+    pub fn reasons(&self) -> &[String] {
+        match self {
+            Status::Suspect(r) | Status::Unfinished(r) => r,
+            _ => &[],
         }
     }
 
     /// `Ok` for no reasons, else `Suspect`.
     pub fn from_reasons(reasons: Vec<String>) -> Status {
-        if reasons.is_empty() {
+        Status::judge(&[], reasons)
+    }
+
+    /// The status of a case that produced a shape: `Unfinished` when any step did not finish (its
+    /// reasons first, then the shape's), else `Suspect` for any shape reason, else `Ok`.
+    pub fn judge(unfinished: &[Unfinished], reasons: Vec<String>) -> Status {
+        if !unfinished.is_empty() {
+            let mut all: Vec<String> = unfinished.iter().map(ToString::to_string).collect();
+            all.extend(reasons);
+            Status::Unfinished(all)
+        } else if reasons.is_empty() {
             Status::Ok
         } else {
             Status::Suspect(reasons)
@@ -128,6 +191,7 @@ impl fmt::Display for Status {
         match self {
             Status::Ok => f.write_str("ok"),
             Status::Suspect(reasons) => write!(f, "suspect: {}", reasons.join("; ")),
+            Status::Unfinished(reasons) => write!(f, "unfinished: {}", reasons.join("; ")),
             Status::Failed(error) => write!(f, "failed: {error}"),
         }
     }
@@ -141,10 +205,14 @@ impl FromStr for Status {
             Ok(Status::Ok)
         } else if let Some(reasons) = s.strip_prefix("suspect: ") {
             Ok(Status::Suspect(reasons.split("; ").map(String::from).collect()))
+        } else if let Some(reasons) = s.strip_prefix("unfinished: ") {
+            Ok(Status::Unfinished(reasons.split("; ").map(String::from).collect()))
         } else if let Some(error) = s.strip_prefix("failed: ") {
             Ok(Status::Failed(error.to_string()))
         } else {
-            Err(format!("a status is `ok`, `suspect: <reasons>` or `failed: <error>`, not `{s}`"))
+            Err(format!(
+                "a status is `ok`, `suspect: <reasons>`, `unfinished: <reasons>` or `failed: <error>`, not `{s}`"
+            ))
         }
     }
 }
@@ -200,6 +268,7 @@ mod tests {
         for s in [
             Status::Ok,
             Status::Suspect(vec!["folds: 1%".into(), "misses its handles".into()]),
+            Status::Unfinished(vec!["stopped at the 500-iteration cap, last step 3.0e-4 of the diagonal".into()]),
             Status::Failed("solver: not positive definite".into()),
         ] {
             assert_eq!(s.to_string().parse::<Status>().unwrap(), s);
@@ -207,6 +276,29 @@ mod tests {
             assert_eq!(serde_json::from_str::<Status>(&json).unwrap(), s);
         }
         assert!("fine".parse::<Status>().is_err());
+    }
+
+    #[test]
+    fn an_unfinished_step_outranks_the_shape_reasons_and_says_where_it_stopped() {
+        let capped = Unfinished {
+            step: 1,
+            steps: 1,
+            iterations: 500,
+            cap: Some(500),
+            last_step: 3.04e-4,
+            tolerance: Some(1e-5),
+        };
+        let s = Status::judge(&[capped], vec!["folds: 0.010% of interior edges turned by more than 90°".into()]);
+        assert!(s.is_unfinished() && s.kind() == "unfinished");
+        assert_eq!(
+            s.to_string(),
+            "unfinished: stopped at the 500-iteration cap, last step 3.0e-4 of the diagonal (tolerance 1e-5); \
+             folds: 0.010% of interior edges turned by more than 90°"
+        );
+        let second = Unfinished { step: 2, steps: 3, iterations: 40, cap: Some(500), ..capped };
+        assert!(second.to_string().starts_with("edit step 2 of 3 stopped after 40 iterations without converging"));
+        assert_eq!(Status::judge(&[], vec![]), Status::Ok);
+        assert!(Status::judge(&[], vec!["x".into()]).is_suspect());
     }
 
     #[test]

@@ -43,7 +43,7 @@ pub fn render_index(
         "table{border-collapse:collapse;font-size:13px;margin:1em 0}\n",
         "th,td{border:1px solid #ccc;padding:3px 7px;text-align:right}\n",
         "th{background:#f0f0f0}td.text{text-align:left}\n",
-        "tr.failed td{background:#fdd}tr.suspect td{background:#fff1d6}\n",
+        "tr.failed td{background:#fdd}tr.suspect td{background:#fff1d6}tr.unfinished td{background:#e4e8ff}\n",
         "td.status{min-width:260px;max-width:360px;font-size:12px}td{white-space:nowrap}\n",
         "td.status{white-space:normal}div.scroll{overflow-x:auto}dl.metrics dt{font-weight:bold;margin-top:.3em}\n",
         ".pass{color:#060}.fail{color:#a00}\n",
@@ -72,7 +72,9 @@ pub fn render_index(
     }
     page.push_str(
         "</dl>\n<p>Status: <code>ok</code>; <code>suspect</code> (highlighted) when the result folds, misses its \
-         handles or leaves its frame, with the reasons (thresholds in <code>configs/verdicts.toml</code>); \
+         handles, leaves its frame or turns a free region far beyond its handles, with the reasons (thresholds in \
+         <code>configs/verdicts.toml</code>); <code>unfinished</code> (blue) when its iteration stopped at the \
+         cap before its tolerance, so the measures are of an iterate, not of the method's answer; \
          <code>failed</code> (red) when the method gave no result.</p>\n",
     );
 

@@ -263,7 +263,8 @@ fn draw_errors<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &[
             row_y.push(chart.backend_coord(&(0.0, y + 0.5)).1);
             let color = method_color(&c.method);
             let text = if value.is_finite() {
-                let style = if c.status.is_suspect() { color.mix(0.4).filled() } else { color.filled() };
+                let faded = c.status.is_suspect() || c.status.is_unfinished();
+                let style = if faded { color.mix(0.4).filled() } else { color.filled() };
                 chart
                     .draw_series(std::iter::once(Rectangle::new(
                         [(0.0, y + 0.15), (value.abs(), y + 0.85)],
@@ -271,8 +272,9 @@ fn draw_errors<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &[
                     )))
                     .map_err(err)?;
                 let mut text = spec.format.apply(Some(*value));
-                if c.status.is_suspect() {
-                    text.push_str(" suspect");
+                if c.status.is_suspect() || c.status.is_unfinished() {
+                    text.push(' ');
+                    text.push_str(c.status.kind());
                 }
                 text
             } else if c.status.is_failed() {

@@ -57,6 +57,7 @@ const EMPTY_CELL: [u8; 3] = [247, 247, 247];
 const FAILED_CELL: [u8; 3] = [250, 238, 238];
 const FAILED_INK: [u8; 3] = [170, 50, 50];
 const SUSPECT_INK: [u8; 3] = [200, 110, 0];
+const UNFINISHED_INK: [u8; 3] = [40, 70, 200];
 
 /// Folder of the figures under the report directory.
 const FIGURES: &str = "figures";
@@ -378,7 +379,10 @@ fn grid_image(
                     if *clipped {
                         marks.push(("clipped: leaves the frame", FAILED_INK));
                     }
-                    if case.is_some_and(|c| c.status.is_suspect()) {
+                    if case.is_some_and(|c| c.status.is_unfinished()) {
+                        marks.push(("unfinished: stopped at its cap", UNFINISHED_INK));
+                    }
+                    if case.is_some_and(|c| c.status.is_suspect() || c.status.reasons().len() > 1) {
                         marks.push(("suspect", SUSPECT_INK));
                     }
                     if let Some((_, color)) = marks.first() {
@@ -741,6 +745,28 @@ mod tests {
         let grid = decode(&dirs[1].path().join("figures/grid.png"));
         let red = grid.pixels().filter(|p| p.0 == FAILED_INK).count();
         assert!(red > 4 * (CELL_SIZE as usize - 4), "the clipped cell is outlined: {red} red pixels");
+    }
+
+    #[test]
+    fn an_unfinished_case_is_outlined_in_its_own_colour() {
+        let (results, scenarios) = inputs();
+        let rest = scenarios[0].mesh.positions().to_vec();
+        let mut with_unfinished = results.clone();
+        with_unfinished.push(case(
+            "tiny",
+            "hirm",
+            "unfinished: stopped at the 500-iteration cap, last step 3.0e-4 of the diagonal",
+            Some(rest),
+        ));
+        let dir = tempfile::tempdir().unwrap();
+        write_figures(dir.path(), &with_unfinished, &scenarios).unwrap();
+        let grid = decode(&dir.path().join("figures/grid.png"));
+        let blue = grid.pixels().filter(|p| p.0 == UNFINISHED_INK).count();
+        assert!(blue > 4 * (CELL_SIZE as usize - 4), "the unfinished cell is outlined: {blue} pixels");
+        let dir = tempfile::tempdir().unwrap();
+        write_figures(dir.path(), &results, &scenarios).unwrap();
+        let grid = decode(&dir.path().join("figures/grid.png"));
+        assert_eq!(grid.pixels().filter(|p| p.0 == UNFINISHED_INK).count(), 0);
     }
 
     #[test]
