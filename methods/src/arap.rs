@@ -81,16 +81,10 @@ pub struct ArapParams {
 /// depth 7 (plain: cylinder 1182, bar 2417, cactus 1468, plane 2210): 280, 175, 239, 388.
 const RESIDUAL_GROWTH_LIMIT: f64 = 2.0;
 
-/// How the local/global iteration is driven (see the module documentation, "Acceleration").
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ArapAcceleration {
-    /// Plain alternation, as Sorkine & Alexa 2007 and libigl's `arap_solve`.
-    None,
-    /// Anderson acceleration with the energy safeguard of Peng et al. 2018.
-    #[default]
-    Anderson,
-}
+/// How the local/global iteration is driven (see the module documentation, "Acceleration"):
+/// `None` is the plain alternation of Sorkine & Alexa 2007 and libigl's `arap_solve`; `Anderson`
+/// adds the energy safeguard of Peng et al. 2018.
+pub use crate::linalg::anderson::Acceleration as ArapAcceleration;
 
 impl Default for ArapParams {
     fn default() -> Self {

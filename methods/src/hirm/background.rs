@@ -19,10 +19,14 @@ use faer::Mat;
 
 use crate::error::MethodError;
 use crate::handles::{HandleRegion, HandleSet};
-use crate::isoline_model::{add_constraint_rows_lower, HandleIndependentSystem, IsolineModel, SetBlend};
+use crate::isoline_model::{
+    add_constraint_rows_lower, HandleIndependentSystem, IsolineModel, ModelFrame, SetBlend,
+};
 
 /// What the handle-independent system is built from besides the base shape: fixed for a rest mesh.
 pub struct SystemInputs {
+    /// The rest mesh's frame the transforms act in (unit-free `mu`, see `ModelFrame`).
+    pub frame: ModelFrame,
     pub triangles: Vec<[u32; 3]>,
     /// `#V x n_field` propagation fields in `[0, 1]`.
     pub fields: Mat<f64>,
@@ -71,6 +75,7 @@ impl KeptConstraints {
 pub fn handle_independent_model(base: &[[f64; 3]], inputs: &SystemInputs) -> HandleIndependentModel {
     let start = Instant::now();
     let mut model = IsolineModel::new(
+        inputs.frame,
         base,
         &inputs.triangles,
         inputs.fields.as_ref(),

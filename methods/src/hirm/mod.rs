@@ -31,6 +31,10 @@
 //! - `bind_handles` waits for a background precompute still running; the wait is reported
 //!   separately (`bind_background_wait`) from the handle update `t_h`.
 //! - The step size is the largest displacement of the vertices of the sampled triangles.
+//! - Acceleration (`acceleration`, default `anderson`): eq 20 iterated as a fixed-point map on the
+//!   transforms, extrapolated from its last `anderson_depth` steps as `isolines` does
+//!   ([`crate::isoline_model::ReducedFixedPoint`]); `"none"` is the paper's plain iteration, and
+//!   the fixed point is the same (tested).
 //! - Field count and isolines per field (section 5, Fig. 5: few propagation fields shear when handles
 //!   are close, more fields cure it). A region moves apart from the others only where some field
 //!   separates them: with the paper's selection (phi = 3.5: 6 fields on the cactus, 5 on the bar)
@@ -47,16 +51,16 @@
 //!   handle-independent system rebuilt on the current shape, synchronously (phase
 //!   `t_g_field_growth`, reported apart from the handle update `t_h`); later handle sets of that
 //!   size or smaller cost only `t_h` again.
-//! - `mu = 0.05`, not the paper's 0.01. Eq 11 weighs `|L W R - sigma|^2`, whose size depends on
-//!   the mesh's units and resolution, against `mu^2 |M R|^2`, whose translation entries are in mesh
-//!   units: the paper's value is tied to its meshes. With 0.01 the iteration is under-damped here:
-//!   the 200K-vertex sweep bar jitters at a step of 1e-4 diagonals for all 500 iterations (its shape
-//!   fixed to 4 digits of E_theta), the survey cactus needs 65 iterations and cactus-handles 78.
-//!   Survey, E_theta / iterations, 0.01 -> 0.05: 200K bar 12.02 / 500 (cap) -> 11.76 / 311, cactus
-//!   5.80 / 65 -> 4.66 / 9, cactus-handles 8.33 / 78 -> 6.74 / 17, cactus-incremental 6.37 -> 5.27,
-//!   bar 9.17 -> 8.95, plane 5.38 -> 5.34. It costs area and volume: bar e_area 0.048 -> 0.066,
-//!   cactus volume change -5.4% -> -9.2%, and the cylinder's E_theta 10.30 -> 11.19. 0.1 loses more
-//!   (bar e_area 0.082, cylinder 11.22 deg); 0.03 leaves the 200K bar at its cap.
+//! - `mu = 0.05`, not the paper's 0.01. Eq 11 weighs `|L W R - sigma|^2` against `mu^2 |M R|^2`;
+//!   the transforms act in the rest mesh's frame (centroid, RMS radius; see
+//!   [`crate::isoline_model::ModelFrame`]), so the balance no longer depends on the mesh's units or
+//!   position (before, the translation entries of `M R` were in mesh units: one knight in metres
+//!   and millimetres gave E_theta 3.39 and 3.25 deg; now 3.19 for both), but it still depends on
+//!   the resolution, and the paper's value is tied to its meshes. With 0.01 the plain iteration was
+//!   under-damped here (measured before the frame and Anderson acceleration: the 200K-vertex sweep
+//!   bar jittered at a step of 1e-4 diagonals for all 500 iterations, the survey cactus needed 65
+//!   iterations), and 0.05 cost area and volume (bar e_area 0.048 -> 0.066, cactus volume change
+//!   -5.4% -> -9.2%).
 //!
 //! Known limitation (real-mesh `max`: nose turned 25 deg, chin pushed, back of the head held): the
 //! result shears a band of the free cheek and folds 0.17% of its edges (E_theta 9.5 deg, `isolines`
@@ -86,8 +90,10 @@ pub use propagation_fields::{propagation_fields, select_fields, PropagationField
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
 use crate::isoline_model::{
-    add_constraint_rows_lower, checked_positions, constraint_rhs, reduced_step, ReducedIteration, RotationFit,
+    add_constraint_rows_lower, checked_positions, constraint_rhs, reduced_step, ReducedFixedPoint,
+    ReducedIteration, RotationFit,
 };
+use crate::linalg::anderson::{Acceleration, MAX_DEPTH};
 use crate::method::{run_iterations, DeformationMethod, IterationObserver, Iterations, SolveSummary};
 use crate::operators::{laplacian, lumped_mass_for, LaplacianWeights, MassKind};
 
@@ -122,6 +128,10 @@ pub struct HirmParams {
     /// The Laplacian's edge weights (module docs): they enter the propagation fields (the
     /// eigenvectors of `L` with its mass) and the Laplacian coordinates `sigma = L X`.
     pub weights: LaplacianWeights,
+    /// `"anderson"` or `"none"` (eq 20 as the paper iterates it); see the module docs.
+    pub acceleration: Acceleration,
+    /// Steps of history Anderson acceleration extrapolates from (at most 16).
+    pub anderson_depth: usize,
 }
 
 impl Default for HirmParams {
@@ -138,6 +148,8 @@ impl Default for HirmParams {
             max_iterations: 500,
             tolerance: 1e-5,
             seed: 0x5eed,
+            acceleration: Acceleration::default(),
+            anderson_depth: 5,
             weights: LaplacianWeights::default(),
         }
     }
@@ -209,14 +221,15 @@ impl Hirm {
             || !(params.fields_per_region >= 0.0 && params.fields_per_region.is_finite())
             || params.max_iterations == 0
             || !(params.tolerance >= 0.0)
+            || params.anderson_depth > MAX_DEPTH
         {
             return Err(MethodError::Parameters {
                 method: "hirm",
-                message:
+                message: format!(
                     "threshold must be > 1, max_fields >= 1, isolines >= 2, max_crossed_triangles >= 1, \
-                          mu >= 0, omega > 0, fields_per_region >= 0 and finite, max_iterations >= 1, \
-                          tolerance >= 0"
-                        .into(),
+                     mu >= 0, omega > 0, fields_per_region >= 0 and finite, max_iterations >= 1, \
+                     tolerance >= 0, anderson_depth <= {MAX_DEPTH}"
+                ),
             });
         }
         Ok(Self {
@@ -290,6 +303,7 @@ impl Hirm {
             self.params.seed,
         )?;
         let inputs = Arc::new(SystemInputs {
+            frame: rest.inputs.frame,
             triangles: rest.inputs.triangles.clone(),
             fields: fields.fields,
             weights: fields.weights,
@@ -341,6 +355,7 @@ impl DeformationMethod for Hirm {
         )?;
         self.set_timing(crate::keys::phase::T_E_PROPAGATION_FIELDS, start.elapsed().as_secs_f64());
         let inputs = Arc::new(SystemInputs {
+            frame: crate::isoline_model::ModelFrame::of(rest.positions()),
             triangles: rest.triangles().to_vec(),
             fields: fields.fields,
             weights: fields.weights,
@@ -436,19 +451,27 @@ impl DeformationMethod for Hirm {
         let constraints = constraint_rhs(model, &bound.handles, targets, self.params.omega);
         let mut probes = model.probe_positions(self.reduced.as_ref());
         let setup = t0.elapsed().as_secs_f64();
-        let iterations =
-            Iterations { first: 0, count: self.params.max_iterations, tolerance: self.params.tolerance };
+        let tolerance = self.params.tolerance;
+        let iterations = Iterations { first: 0, count: self.params.max_iterations, tolerance };
         let factor = self.normal_factor.as_ref();
+        let mut fixed_point =
+            ReducedFixedPoint::new(self.params.acceleration, self.params.anderson_depth, self.reduced.nrows());
         let iterate = |reduced: &mut Mat<f64>, iteration: usize| -> Result<f64, MethodError> {
+            fixed_point.begin(reduced.as_ref());
             // Eq 17-19, then eq 20 (eq 27 with T_2 = W^T L^T W_sigma R_sigma).
             let rotations = model.isoline_rotations(&probes, RotationFit::ScaledOrthogonal);
             let mut rhs = &system.laplacian_rhs * &rotations;
             rhs += &constraints;
             let it = ReducedIteration { method: "hirm", iteration, model, factor };
-            reduced_step(it, rhs, reduced, &mut probes, rest.bbox_diagonal)
+            let step = reduced_step(it, rhs, reduced, &mut probes, rest.bbox_diagonal)?;
+            fixed_point.advance("hirm", iteration, model, reduced, &mut probes, step < tolerance)?;
+            Ok(step)
         };
         let shape = |reduced: &Mat<f64>| model.positions(reduced.as_ref());
         let summary = run_iterations(iterations, &mut self.reduced, iterate, shape, observer)?;
+        if !summary.converged {
+            fixed_point.end_unconverged(&mut self.reduced);
+        }
         // Eq 21 / 28 for every vertex, once.
         let t1 = Instant::now();
         let current = checked_positions("hirm", model, self.reduced.as_ref(), summary.iterations)?;

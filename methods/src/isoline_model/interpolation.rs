@@ -4,8 +4,20 @@
 //! two-level interpolation weights `w_{k,m}` of every vertex (section 4.2: linear between the two
 //! isolines around `phi_{i,k}`, times the set weight of [`SetBlend`]: `phi_{i,k}` across handles, or
 //! HIRM's constant `omega_bar_i`), and the sampled crossed triangles with their base frames. With the weights, `W_x[k, 4m + c] = w_{k,m} x_bar_k[c]` (homogeneous
-//! `x_bar_k`) and `W_delta[k, 3m + c] = w_{k,m} delta_bar_k[c]`; both are applied row by row and never
-//! stored densely (`#V x 4N` would not fit for large meshes with many handles).
+//! `x_bar_k`, in the model's [`ModelFrame`]) and `W_delta[k, 3m + c] = w_{k,m} delta_bar_k[c]`; both
+//! are applied row by row and never stored densely (`#V x 4N` would not fit for large meshes with
+//! many handles).
+//!
+//! Decision (units): the transforms act on `x_bar_k = (x_k - c) / l`, the base positions in the
+//! model's frame ([`ModelFrame`]: `c` the rest centroid, `l` the rest RMS radius), not on the mesh
+//! coordinates. The smoothness term `beta^2 |M R|^2` (eq 5; HIRM's `mu`, eq 11-12) sums squared
+//! differences of all 12 entries of neighbouring transforms: on mesh coordinates their linear parts
+//! are unitless and their translations in mesh units, so the term's balance against the Laplacian
+//! term changed with the mesh's units (`hirm` on one model in metres and millimetres: E_theta 1.33
+//! against 1.41 deg), and with its position (a translation `T` of the scene turns the translation
+//! differences into `dt - dA T`). In the frame both parts are in units of `l`, every term of eq 5-6
+//! scales with the square of the mesh's size, and results are invariant to scaling, translating and
+//! rotating the scene. The transforms `R` are still the paper's affine maps, written in that frame.
 //!
 //! [`HandleIndependentSystem`] holds the parts of eq 10's matrices that do not depend on the handles
 //! (`W_x^T L^T L W_x + beta^2 M^T M`, `W_x^T L^T W_delta`); [`ReducedSystem`] adds a handle set's
@@ -35,6 +47,39 @@ pub enum SetBlend {
     FieldValues,
     /// By one constant weight per set (HIRM eq 8, the normalized importances `omega_bar_i`).
     PerSet(Vec<f64>),
+}
+
+/// The frame the reduced transforms act in (see the module docs): positions enter `W_x` as
+/// `(x - center) / length`. Made from the rest mesh, so every model of one method shares it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModelFrame {
+    /// Centroid of the rest vertices.
+    pub center: [f64; 3],
+    /// RMS distance of the rest vertices from `center` (> 0).
+    pub length: f64,
+}
+
+impl ModelFrame {
+    /// The frame of the `#V x 3` rest positions `rest`: moves with the mesh under any rigid motion
+    /// and scales with it. A degenerate (single-point) mesh gets length 1.
+    pub fn of(rest: &[[f64; 3]]) -> Self {
+        let n = rest.len().max(1) as f64;
+        let mut center = [0.0; 3];
+        for p in rest {
+            for a in 0..3 {
+                center[a] += p[a] / n;
+            }
+        }
+        let mean_square = rest.iter().map(|p| dot(sub(*p, center), sub(*p, center))).sum::<f64>() / n;
+        let length = mean_square.sqrt();
+        Self { center, length: if length > 0.0 && length.is_finite() { length } else { 1.0 } }
+    }
+
+    /// `(x - center) / length` with the homogeneous 1.
+    fn homogeneous(&self, x: [f64; 3]) -> [f64; 4] {
+        let d = sub(x, self.center);
+        [d[0] / self.length, d[1] / self.length, d[2] / self.length, 1.0]
+    }
 }
 
 /// One isoline `(set, j)` and its sampled crossed triangles.
@@ -72,6 +117,7 @@ struct Sample {
 pub struct IsolineModel {
     n_iso: usize,
     n_sets: usize,
+    frame: ModelFrame,
     base: Vec<[f64; 3]>,
     /// `L x_bar` of the base shape, `#V`.
     base_delta: Vec<[f64; 3]>,
@@ -87,9 +133,10 @@ pub struct IsolineModel {
 impl IsolineModel {
     /// Build the model on the `#V x 3` base shape `base` from `#V x #sets` scalar fields with values
     /// in `[0, 1]` (one isoline set per column): `n_iso` isolines per set, at most
-    /// `max_crossed_triangles` sampled triangles in all, sets blended by `blend`.
-    /// `delta_bar = L X_base` is filled in by [`HandleIndependentSystem::new`], which has `L`.
+    /// `max_crossed_triangles` sampled triangles in all, sets blended by `blend`, transforms acting in
+    /// `frame`. `delta_bar = L X_base` is filled in by [`HandleIndependentSystem::new`], which has `L`.
     pub fn new(
+        frame: ModelFrame,
         base: &[[f64; 3]],
         triangles: &[[u32; 3]],
         fields: MatRef<'_, f64>,
@@ -174,6 +221,7 @@ impl IsolineModel {
         Self {
             n_iso,
             n_sets,
+            frame,
             base: base.to_vec(),
             base_delta: Vec::new(),
             row_start,
@@ -209,9 +257,25 @@ impl IsolineModel {
         &self.base_delta
     }
 
-    /// `R_x` (`4N x 3`, column per coordinate) of identity transforms: `W_x R_x = X_base`.
+    /// The frame the transforms act in.
+    pub fn frame(&self) -> ModelFrame {
+        self.frame
+    }
+
+    /// Row `k` of `W_x` before the isoline weights: `(x_bar_k - c) / l` and 1 (see [`ModelFrame`]).
+    fn homogeneous(&self, k: usize) -> [f64; 4] {
+        self.frame.homogeneous(self.base[k])
+    }
+
+    /// `R_x` (`4N x 3`, column per coordinate) of identity transforms: `W_x R_x = X_base`. In the
+    /// model's frame the identity is `x = l x_bar + c`: linear part `l I`, translation `c`.
     pub fn identity_transforms(&self) -> Mat<f64> {
-        Mat::from_fn(4 * self.n_isolines(), 3, |row, a| if row % 4 == a { 1.0 } else { 0.0 })
+        let ModelFrame { center, length } = self.frame;
+        Mat::from_fn(4 * self.n_isolines(), 3, |row, a| match row % 4 {
+            3 => center[a],
+            c if c == a => length,
+            _ => 0.0,
+        })
     }
 
     /// `R_delta` (`3N x 3`) of identity rotations: `W_delta R_delta = delta_bar`.
@@ -221,8 +285,7 @@ impl IsolineModel {
 
     /// `(W_x R_x)_k`: vertex `k` under the reduced variables `reduced` (`4N x 3`).
     pub fn position(&self, k: usize, reduced: MatRef<'_, f64>) -> [f64; 3] {
-        let x = self.base[k];
-        let h = [x[0], x[1], x[2], 1.0];
+        let h = self.homogeneous(k);
         let mut out = [0.0; 3];
         for &(m, w) in self.vertex_weights(k) {
             let row = 4 * m as usize;
@@ -359,8 +422,7 @@ impl IsolineModel {
 
     /// `W_x` row `k`: `(column, value)` pairs.
     fn position_row(&self, k: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
-        let x = self.base[k];
-        let h = [x[0], x[1], x[2], 1.0];
+        let h = self.homogeneous(k);
         self.vertex_weights(k)
             .iter()
             .flat_map(move |&(m, w)| (0..4).map(move |c| (4 * m as usize + c, w * h[c])))
@@ -568,7 +630,7 @@ impl HandleIndependentSystem {
 /// eq 26 added vertex by vertex, in the given order, so a matrix that already holds the term of some
 /// regions grows to the same bits as one built whole.
 ///
-/// Row `k` of `Phi W_x` is `w_k (x) (x_k, 1)`: per isoline `m` of vertex `k`, 4 contiguous
+/// Row `k` of `Phi W_x` is `w_k (x) (x_bar_k, 1)`: per isoline `m` of vertex `k`, 4 contiguous
 /// columns. Only the blocks of isoline pairs `(p, q)` with `p >= q` are accumulated, 4 wide.
 pub fn add_constraint_rows_lower(
     model: &IsolineModel,
@@ -578,8 +640,7 @@ pub fn add_constraint_rows_lower(
 ) {
     let w2 = omega * omega;
     for v in vertices {
-        let x = model.base[v as usize];
-        let h = [x[0], x[1], x[2], 1.0];
+        let h = model.homogeneous(v as usize);
         let local = model.vertex_weights(v as usize);
         for &(mq, wq) in local {
             let q = 4 * mq as usize;

@@ -16,11 +16,12 @@ use faer::{Mat, MatRef};
 use meshes::vector::{cross, dot, normalize_or_zero, scale, sub};
 
 pub use interpolation::{
-    add_constraint_rows_lower, constraint_rhs, HandleIndependentSystem, IsolineModel, ReducedSystem,
-    RotationFit, SetBlend,
+    add_constraint_rows_lower, constraint_rhs, HandleIndependentSystem, IsolineModel, ModelFrame,
+    ReducedSystem, RotationFit, SetBlend,
 };
 
 use crate::error::MethodError;
+use crate::linalg::anderson::{Acceleration, FixedPointIteration};
 
 /// What [`reduced_step`] needs to know of the iteration and the bound model.
 pub(crate) struct ReducedIteration<'a> {
@@ -76,6 +77,90 @@ pub(crate) fn reduced_step(
     check_divergence(it.method, it.iteration, step)?;
     *probes = next;
     Ok(step)
+}
+
+/// The reduced iteration `R <- T(R)` (eq 10; HIRM eq 20) as a fixed-point iteration on the `4N x 3`
+/// transforms, plain or Anderson-accelerated ([`FixedPointIteration`]). The step that converges
+/// is the plain one (the probes' displacement from `R` to `T(R)`), so acceleration changes the path,
+/// not the fixed point. Per-iteration cost `O(N)` plus one more probe evaluation: still independent
+/// of `#V`.
+pub(crate) struct ReducedFixedPoint {
+    iteration: FixedPointIteration,
+    /// `R` before the step and `T(R)`, flattened column by column.
+    x: Vec<f64>,
+    g: Vec<f64>,
+}
+
+/// Anderson's history is dropped when the plain step more than doubles in one iteration (as `arap`).
+const RESIDUAL_GROWTH_LIMIT: f64 = 2.0;
+
+impl ReducedFixedPoint {
+    /// For `reduced` transforms of `rows x 3`.
+    pub fn new(acceleration: Acceleration, depth: usize, rows: usize) -> Self {
+        let dimension = 3 * rows;
+        let iteration = FixedPointIteration::new(acceleration, depth, dimension, RESIDUAL_GROWTH_LIMIT);
+        let buffers = if iteration.is_accelerated() { dimension } else { 0 };
+        Self { iteration, x: vec![0.0; buffers], g: vec![0.0; buffers] }
+    }
+
+    /// Keep `R` (call before the step).
+    pub fn begin(&mut self, reduced: MatRef<'_, f64>) {
+        if self.iteration.is_accelerated() {
+            flatten(reduced, &mut self.x);
+        }
+    }
+
+    /// After the step left `T(R)` in `reduced` and its probes in `probes`: move on to the next
+    /// iterate (extrapolated unless `converged`) and its probes. Errors: a non-finite probe of an
+    /// extrapolated iterate.
+    pub fn advance(
+        &mut self,
+        method: &'static str,
+        iteration: usize,
+        model: &IsolineModel,
+        reduced: &mut Mat<f64>,
+        probes: &mut Vec<[f64; 3]>,
+        converged: bool,
+    ) -> Result<(), MethodError> {
+        if !self.iteration.is_accelerated() {
+            return Ok(());
+        }
+        flatten(reduced.as_ref(), &mut self.g);
+        if self.iteration.advance(&mut self.x, &self.g, converged) {
+            unflatten(&self.x, reduced.as_mut());
+            let next = model.probe_positions(reduced.as_ref());
+            if let Some(i) = next.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+                return Err(MethodError::NonFinite { method, vertex: model.probe_vertex(i) as usize, iteration });
+            }
+            *probes = next;
+        }
+        Ok(())
+    }
+
+    /// After a solve that ended unconverged: the last `T(R)` into `reduced` (not an extrapolation).
+    pub fn end_unconverged(&self, reduced: &mut Mat<f64>) {
+        if self.iteration.is_accelerated() {
+            unflatten(self.iteration.last_image(), reduced.as_mut());
+        }
+    }
+}
+
+fn flatten(m: MatRef<'_, f64>, out: &mut [f64]) {
+    let rows = m.nrows();
+    for j in 0..m.ncols() {
+        for i in 0..rows {
+            out[j * rows + i] = m[(i, j)];
+        }
+    }
+}
+
+fn unflatten(values: &[f64], mut m: faer::MatMut<'_, f64>) {
+    let rows = m.nrows();
+    for j in 0..m.ncols() {
+        for i in 0..rows {
+            m[(i, j)] = values[j * rows + i];
+        }
+    }
 }
 
 /// `W_x R_x` for every vertex (`#V x 3`), or the first non-finite vertex as an error.

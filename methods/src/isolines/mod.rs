@@ -42,6 +42,10 @@
 //!   formed once per solve at `O(#constrained)` cost, outside the iterations).
 //! - Step size: the largest displacement of the vertices of the sampled triangles (the only
 //!   positions the iteration computes), over the bounding-box diagonal.
+//! - Acceleration (`acceleration`, default `anderson`): eq 10 is a fixed-point map on the
+//!   transforms, `R <- T(R)`; Anderson acceleration extrapolates from its last `anderson_depth`
+//!   steps ([`ReducedFixedPoint`]), `"none"` is the paper's plain iteration. The step that must fall
+//!   below the tolerance is the plain one either way, so the fixed point does not move (tested).
 
 pub mod harmonic_fields;
 
@@ -57,8 +61,10 @@ pub use harmonic_fields::harmonic_fields;
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
 use crate::isoline_model::{
-    checked_positions, reduced_step, IsolineModel, ReducedIteration, ReducedSystem, RotationFit, SetBlend,
+    checked_positions, reduced_step, IsolineModel, ModelFrame, ReducedFixedPoint, ReducedIteration,
+    ReducedSystem, RotationFit, SetBlend,
 };
+use crate::linalg::anderson::{Acceleration, MAX_DEPTH};
 use crate::laplacian_coordinates::RotationInvariantCoordinates;
 use crate::method::{run_iterations, DeformationMethod, IterationObserver, Iterations, SolveSummary};
 use crate::operators::{laplacian, LaplacianWeights};
@@ -96,6 +102,10 @@ pub struct IsolinesParams {
     pub tolerance: f64,
     /// Weights of `L` (see the module documentation).
     pub weights: LaplacianWeights,
+    /// `"anderson"` or `"none"` (eq 10 as the paper iterates it); see the module documentation.
+    pub acceleration: Acceleration,
+    /// Steps of history Anderson acceleration extrapolates from (at most 16).
+    pub anderson_depth: usize,
 }
 
 impl Default for IsolinesParams {
@@ -109,6 +119,8 @@ impl Default for IsolinesParams {
             max_iterations: 500,
             tolerance: 1e-5,
             weights: LaplacianWeights::default(),
+            acceleration: Acceleration::default(),
+            anderson_depth: 5,
         }
     }
 }
@@ -118,6 +130,8 @@ struct Rest {
     triangles: Vec<[u32; 3]>,
     topology: Topology,
     laplacian: faer::sparse::SparseColMat<usize, f64>,
+    /// The frame the reduced transforms act in (unit-free smoothness, see `ModelFrame`).
+    frame: ModelFrame,
     bbox_diagonal: f64,
 }
 
@@ -153,12 +167,14 @@ impl Isolines {
             || !(params.omega > 0.0)
             || params.max_iterations == 0
             || !(params.tolerance >= 0.0)
+            || params.anderson_depth > MAX_DEPTH
         {
             return Err(MethodError::Parameters {
                 method: name,
-                message: "isolines must be >= 2, max_crossed_triangles >= 1, beta >= 0, omega > 0, \
-                          max_iterations >= 1, tolerance >= 0"
-                    .into(),
+                message: format!(
+                    "isolines must be >= 2, max_crossed_triangles >= 1, beta >= 0, omega > 0, \
+                     max_iterations >= 1, tolerance >= 0, anderson_depth <= {MAX_DEPTH}"
+                ),
             });
         }
         Ok(Self {
@@ -191,6 +207,7 @@ impl DeformationMethod for Isolines {
             triangles: rest.triangles().to_vec(),
             topology,
             laplacian,
+            frame: ModelFrame::of(rest.positions()),
             bbox_diagonal: rest.bbox_diagonal(),
         });
         self.bound = None;
@@ -221,6 +238,7 @@ impl DeformationMethod for Isolines {
         // Two handles: one set on the first field (the second is its complement).
         let sets = if fields.ncols() == 2 { fields.as_ref().subcols(0, 1) } else { fields.as_ref() };
         let mut model = IsolineModel::new(
+            rest.frame,
             &self.current,
             &rest.triangles,
             sets,
@@ -276,9 +294,12 @@ impl DeformationMethod for Isolines {
         let mut delta =
             Mat::<f64>::zeros(if bound.coordinates.is_some() { self.current.len() } else { 0 }, 3);
         let setup = t0.elapsed().as_secs_f64();
-        let iterations =
-            Iterations { first: 0, count: self.params.max_iterations, tolerance: self.params.tolerance };
+        let tolerance = self.params.tolerance;
+        let iterations = Iterations { first: 0, count: self.params.max_iterations, tolerance };
+        let mut fixed_point =
+            ReducedFixedPoint::new(self.params.acceleration, self.params.anderson_depth, self.reduced.nrows());
         let iterate = |reduced: &mut Mat<f64>, iteration: usize| -> Result<f64, MethodError> {
+            fixed_point.begin(reduced.as_ref());
             let mut rhs = constraint_rhs.clone();
             match &mut bound.coordinates {
                 None => {
@@ -297,10 +318,15 @@ impl DeformationMethod for Isolines {
             }
             let it =
                 ReducedIteration { method: name, iteration, model: &bound.model, factor: bound.factor.L() };
-            reduced_step(it, rhs, reduced, &mut probes, rest.bbox_diagonal)
+            let step = reduced_step(it, rhs, reduced, &mut probes, rest.bbox_diagonal)?;
+            fixed_point.advance(name, iteration, &bound.model, reduced, &mut probes, step < tolerance)?;
+            Ok(step)
         };
         let shape = |reduced: &Mat<f64>| bound.model.positions(reduced.as_ref());
         let summary = run_iterations(iterations, &mut self.reduced, iterate, shape, observer)?;
+        if !summary.converged {
+            fixed_point.end_unconverged(&mut self.reduced);
+        }
         let t1 = Instant::now();
         self.current = checked_positions(name, &bound.model, self.reduced.as_ref(), summary.iterations)?;
         self.timings.retain(|(k, _)| !k.starts_with(crate::keys::phase::SOLVE_PREFIX));

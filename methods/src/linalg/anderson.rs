@@ -1,11 +1,81 @@
 //! Anderson acceleration (type II; Walker & Ni 2011) of a fixed-point iteration `x <- T(x)`, as
-//! Peng et al. 2018 use it for local/global geometry solvers: `arap`'s local/global map and
-//! `scale_aware`'s Algorithm 1. It changes the path, not the fixed points: a converged `x` has
+//! Peng et al. 2018 use it for local/global geometry solvers: `arap`'s local/global map,
+//! `scale_aware`'s Algorithm 1, and the Gauss-Newton-like iterations of Laplacian editing
+//! (`laplacian`, and the reduced ones of `isolines*` and `hirm` on their transforms). It changes the path, not the fixed points: a converged `x` has
 //! `T(x) = x` either way.
 //!
 //! Safeguard (on by default; [`AndersonAcceleration::with_residual_growth_limit`] for callers with
 //! an energy to test, as `arap`): when the residual `|T(x) - x|` grows, the history is dropped and
 //! the plain step `x <- T(x)` is taken (scale_aware's Algorithm 1 has no monotone energy).
+
+use serde::Deserialize;
+
+/// How a method drives its fixed-point iteration (`acceleration` in configs/methods.toml).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Acceleration {
+    /// The plain iteration `x <- T(x)`, as the papers give it.
+    None,
+    /// Anderson acceleration over the last `anderson_depth` steps ([`AndersonAcceleration`]).
+    #[default]
+    Anderson,
+}
+
+/// The iterate of a fixed-point iteration `x <- T(x)` moved on by its image, plainly or by
+/// Anderson acceleration. The caller computes `g = T(x)` and judges the plain step `|g - x|`
+/// against its tolerance (so the stopping test is the same either way), then calls
+/// [`FixedPointIteration::advance`]. A converged step, or the plain iteration, takes `x <- g`; an
+/// unconverged accelerated one extrapolates. When the solve ends unconverged the caller should
+/// return [`FixedPointIteration::last_image`], the last `T(x)`, the iterate a plain iteration would
+/// have.
+pub struct FixedPointIteration {
+    anderson: Option<AndersonAcceleration>,
+    image: Vec<f64>,
+    next: Vec<f64>,
+}
+
+impl FixedPointIteration {
+    /// For iterates of `dimension` entries: Anderson acceleration of depth `depth` (history dropped
+    /// when the residual grows by more than `residual_growth_limit` in one step) when `acceleration`
+    /// asks for it and `depth > 0`, else the plain iteration.
+    pub fn new(acceleration: Acceleration, depth: usize, dimension: usize, residual_growth_limit: f64) -> Self {
+        let accelerated = acceleration == Acceleration::Anderson && depth > 0;
+        Self {
+            anderson: accelerated.then(|| {
+                AndersonAcceleration::new(depth, dimension).with_residual_growth_limit(residual_growth_limit)
+            }),
+            image: vec![0.0; dimension],
+            next: vec![0.0; if accelerated { dimension } else { 0 }],
+        }
+    }
+
+    /// Whether steps are extrapolated.
+    pub fn is_accelerated(&self) -> bool {
+        self.anderson.is_some()
+    }
+
+    /// Move `x` on, given its image `g = T(x)` and whether the plain step `|g - x|` was below the
+    /// tolerance; returns whether `x` is now other than `g` (an extrapolated iterate).
+    pub fn advance(&mut self, x: &mut [f64], g: &[f64], converged: bool) -> bool {
+        self.image.copy_from_slice(g);
+        match &mut self.anderson {
+            Some(anderson) if !converged => {
+                anderson.next(x, g, &mut self.next);
+                x.copy_from_slice(&self.next);
+                true
+            }
+            _ => {
+                x.copy_from_slice(g);
+                false
+            }
+        }
+    }
+
+    /// The last image `T(x)` given to [`FixedPointIteration::advance`].
+    pub fn last_image(&self) -> &[f64] {
+        &self.image
+    }
+}
 
 /// The last `depth` differences of images `Delta g` and residuals `Delta f`, in fixed storage.
 pub struct AndersonAcceleration {

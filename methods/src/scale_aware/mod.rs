@@ -200,6 +200,7 @@ impl ScaleAware {
             weights: params.weights,
             max_iterations: 1,
             tolerance: 0.0,
+            ..LaplacianParams::default()
         })?;
         Ok(Self {
             name,
