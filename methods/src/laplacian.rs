@@ -11,11 +11,10 @@
 //!   everything `L` does: the rest coordinates `delta = L X_rest`, the normal matrix `L^T L` and the
 //!   right-hand side `L^T delta(X)`; the rest shape stays a fixed point for any weights since both
 //!   sides use the same `L`.
-//! - `delta(X)` update: the rest Laplacian coordinates `delta_i = (L X_rest)_i` are stored in a local
-//!   frame per vertex and re-expressed in the frame of the current surface each iteration
-//!   ([`crate::laplacian_coordinates`]) — the rotation-invariant encoding of Lipman et al. 2005, used
-//!   by the iterative frameworks Au 2007 cites [Au et al. 2006; Huang et al. 2006]. The rest shape is a
-//!   fixed point.
+//! - `delta(X)` update: the rest Laplacian coordinates `delta_i = (L X_rest)_i` turned by the
+//!   rotation each vertex's one-ring made from the rest shape (Procrustes fit,
+//!   [`crate::laplacian_coordinates`], where the choice and the one it replaced are written down).
+//!   The rest shape is a fixed point.
 //! - `X^0` is the current shape (eq 3: "the current edited vertex positions"); from the rest shape
 //!   iteration 0 therefore solves with the un-rotated `delta`, i.e. linear Laplacian editing
 //!   (Lipman et al. 2004 / Sorkine et al. 2004 without their implicit transform).
@@ -80,7 +79,7 @@ impl Default for LaplacianParams {
 /// Anderson's history is dropped when the plain step more than doubles in one iteration (as `arap`).
 const RESIDUAL_GROWTH_LIMIT: f64 = 2.0;
 
-/// Rest-state data: operator, rest Laplacian coordinates in local frames.
+/// Rest-state data: operator, rest Laplacian coordinates and one-rings.
 struct RestState {
     laplacian: SparseColMat<usize, f64>,
     normal_matrix: SparseColMat<usize, f64>,
@@ -162,7 +161,6 @@ impl DeformationMethod for LaplacianEditing {
 
         let coordinates = RotationInvariantCoordinates::new(
             positions,
-            rest_mesh.triangles(),
             &topology,
             laplacian.as_ref(),
         );

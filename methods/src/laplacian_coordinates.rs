@@ -1,81 +1,92 @@
-//! Rotation-invariant Laplacian coordinates `delta(X)` (Lipman et al. 2005), the nonlinear right-hand
-//! side of iterative Laplacian editing (Au et al. 2007, eq 1-3): the Laplacian coordinates of a base
-//! shape are stored in a local frame per vertex (area-weighted vertex normal `n_i`; tangent `t_i` = the
-//! edge to the lowest-index neighbour projected onto the tangent plane; `b_i = n_i x t_i`) and
-//! re-expressed in the frame of the current surface. The base shape is a fixed point.
+//! Rotation-invariant Laplacian coordinates `delta(X)`, the nonlinear right-hand side of iterative
+//! Laplacian editing (Au et al. 2007, eq 1-3): the Laplacian coordinates `delta_bar_i = (L X_base)_i`
+//! of a base shape, turned at every vertex by the rotation its one-ring made from the base shape to
+//! the current one, `delta_i(X) = R_i delta_bar_i`. The base shape is a fixed point (`R_i = I`).
+//!
+//! Decision (the paper leaves the update of `delta(X)` to the frameworks it cites [Au et al. 2006;
+//! Huang et al. 2006]): `R_i` is the rotation closest to `sum_j (x_i - x_j)(x_bar_i - x_bar_j)^T`
+//! over the one-ring (orthogonal Procrustes, ARAP's local step with uniform weights). Until issue 24
+//! it was the frame of Lipman et al. 2005 (the vertex normal and one edge projected onto the
+//! tangent plane): on scans with short, skinny edges that one edge turns the frame with every small
+//! move of its two vertices, and the iteration never settled. On the 43K armadillo, `laplacian`
+//! (Anderson-accelerated or not) and `isolines_t1` bounced at steps of 1e-3 of the diagonal to their
+//! caps; the fitted rotation averages the whole one-ring.
 
 use faer::sparse::linalg::matmul::sparse_dense_matmul;
 use faer::sparse::SparseColMatRef;
 use faer::{Accum, Mat, MatMut, Par};
-use meshes::vector::{cross, dot, normalize_or_zero, scale, sub};
+use meshes::vector::sub;
 use meshes::Topology;
 
-/// Base-shape Laplacian coordinates in local frames, and the buffers to re-express them.
+use crate::rotation_fit::{closest_rotation_warm, Mat3};
+
+/// Identity, the start of every warm-started singular frame.
+const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+/// Base-shape Laplacian coordinates, the base one-rings, and per-vertex warm starts of the fit.
 pub(crate) struct RotationInvariantCoordinates {
-    triangles: Vec<[u32; 3]>,
-    /// Per vertex, the neighbour whose edge defines the tangent `t_i`.
-    frame_neighbor: Vec<u32>,
-    /// `delta_i` of the base shape as `(n, t, b)` coefficients.
-    frame_coefficients: Vec<[f64; 3]>,
-    normals: Vec<[f64; 3]>,
+    /// One-rings in CSR: vertex `i` has `neighbors[offsets[i]..offsets[i + 1]]`.
+    offsets: Vec<usize>,
+    neighbors: Vec<u32>,
+    /// `x_bar_i - x_bar_j` of every one-ring edge, in the order of `neighbors`.
+    base_edges: Vec<[f64; 3]>,
+    /// `delta_bar_i = (L X_base)_i`, `#V x 3`.
+    base_delta: Vec<[f64; 3]>,
+    /// Right singular frames of the last fit per vertex (warm starts, see `closest_rotation_warm`).
+    frames: Vec<Mat3>,
 }
 
 impl RotationInvariantCoordinates {
-    /// Encode `L X_base` (`laplacian`: `#V x #V`; `base`: `#V x 3`) in the local frames of `base`.
+    /// `L X_base` (`laplacian`: `#V x #V`; `base`: `#V x 3`) and the one-rings of `topology` on
+    /// `base`.
     pub(crate) fn new(
         base: &[[f64; 3]],
-        triangles: &[[u32; 3]],
         topology: &Topology,
         laplacian: SparseColMatRef<'_, usize, f64>,
     ) -> Self {
         let n = base.len();
         let base_positions = Mat::from_fn(n, 3, |i, a| base[i][a]);
-        let mut base_delta = Mat::zeros(n, 3);
-        sparse_dense_matmul(
-            base_delta.as_mut(),
-            Accum::Replace,
-            laplacian,
-            base_positions.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-        let normals = meshes::geometry::vertex_normals(base, triangles);
-        let mut frame_neighbor = Vec::with_capacity(n);
-        let mut frame_coefficients = Vec::with_capacity(n);
-        for i in 0..n {
-            // Isolated vertices have no neighbour; they keep a zero delta.
-            let neighbor = topology.one_ring(i).first().copied().unwrap_or(i as u32);
-            let (nn, t, b) = local_frame(base, &normals, neighbor, i);
-            let d = [base_delta[(i, 0)], base_delta[(i, 1)], base_delta[(i, 2)]];
-            frame_neighbor.push(neighbor);
-            frame_coefficients.push([dot(d, nn), dot(d, t), dot(d, b)]);
+        let mut delta = Mat::zeros(n, 3);
+        sparse_dense_matmul(delta.as_mut(), Accum::Replace, laplacian, base_positions.as_ref(), 1.0, Par::Seq);
+        let mut offsets = Vec::with_capacity(n + 1);
+        let mut neighbors = Vec::new();
+        let mut base_edges = Vec::new();
+        offsets.push(0);
+        for (i, x) in base.iter().enumerate() {
+            for &j in topology.one_ring(i) {
+                neighbors.push(j);
+                base_edges.push(sub(*x, base[j as usize]));
+            }
+            offsets.push(neighbors.len());
         }
-        Self { triangles: triangles.to_vec(), frame_neighbor, frame_coefficients, normals }
+        Self {
+            offsets,
+            neighbors,
+            base_edges,
+            base_delta: (0..n).map(|i| [delta[(i, 0)], delta[(i, 1)], delta[(i, 2)]]).collect(),
+            frames: vec![IDENTITY; n],
+        }
     }
 
-    /// `delta(X)` of the `#V x 3` positions `current` into the `#V x 3` matrix `out`.
+    /// `delta(X)` of the `#V x 3` positions `current` into the `#V x 3` matrix `out`. Isolated
+    /// vertices (no one-ring) have `delta_bar = 0` and stay 0.
     pub(crate) fn evaluate(&mut self, current: &[[f64; 3]], mut out: MatMut<'_, f64>) {
-        meshes::geometry::vertex_normals_into(current, &self.triangles, &mut self.normals);
-        for i in 0..current.len() {
-            let (n, t, b) = local_frame(current, &self.normals, self.frame_neighbor[i], i);
-            let c = self.frame_coefficients[i];
+        for (i, xi) in current.iter().enumerate() {
+            let mut covariance = [[0.0; 3]; 3];
+            for s in self.offsets[i]..self.offsets[i + 1] {
+                let d = sub(*xi, current[self.neighbors[s] as usize]);
+                let e = self.base_edges[s];
+                for a in 0..3 {
+                    for b in 0..3 {
+                        covariance[a][b] += d[a] * e[b];
+                    }
+                }
+            }
+            let r = closest_rotation_warm(&covariance, &mut self.frames[i]);
+            let c = self.base_delta[i];
             for a in 0..3 {
-                out[(i, a)] = c[0] * n[a] + c[1] * t[a] + c[2] * b[a];
+                out[(i, a)] = r[a][0] * c[0] + r[a][1] * c[1] + r[a][2] * c[2];
             }
         }
     }
-}
-
-/// Orthonormal frame `(n, t, b)` at vertex `i`: the vertex normal, the edge to `neighbor` projected onto
-/// the tangent plane, and their cross product. Degenerate frames come out as zero vectors.
-fn local_frame(
-    positions: &[[f64; 3]],
-    normals: &[[f64; 3]],
-    neighbor: u32,
-    i: usize,
-) -> ([f64; 3], [f64; 3], [f64; 3]) {
-    let n = normals[i];
-    let e = sub(positions[neighbor as usize], positions[i]);
-    let t = normalize_or_zero(sub(e, scale(n, dot(e, n))));
-    (n, t, cross(n, t))
 }
