@@ -116,7 +116,7 @@ impl Default for IsolinesParams {
             beta: 0.01,
             omega: 1000.0,
             laplacian_coordinates: LaplacianCoordinates::Isolines,
-            max_iterations: 500,
+            max_iterations: 2000,
             tolerance: 1e-5,
             weights: LaplacianWeights::default(),
             acceleration: Acceleration::default(),
@@ -261,7 +261,6 @@ impl DeformationMethod for Isolines {
         let coordinates = (self.params.laplacian_coordinates == LaplacianCoordinates::Vertices).then(|| {
             RotationInvariantCoordinates::new(
                 &self.current,
-                &rest.triangles,
                 &rest.topology,
                 rest.laplacian.as_ref(),
             )

@@ -111,7 +111,7 @@ impl Default for ScaleAwareParams {
     fn default() -> Self {
         Self {
             constraint_weight: 100.0,
-            max_iterations: 50,
+            max_iterations: 200,
             tolerance: 1e-4,
             normal_iterations: 20,
             normal_tolerance: 1e-4,
