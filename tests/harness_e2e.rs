@@ -78,6 +78,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
                 "e_area",
                 "e_length",
                 "folds",
+                "turn_beyond_handles_deg",
                 "precompute_s",
                 "bind_s",
                 "median_iteration_ms",
@@ -880,9 +881,10 @@ fn unreferenced_vertices_are_dropped_and_results_keep_the_input_order() {
     assert!(page.contains("1 unreferenced vertices dropped"), "the note is on the page");
 }
 
-/// The real-mesh suite (`configs/real-meshes`): three meshes of `../shared/real-meshes` in OFF and
+/// The real-mesh suite (`configs/real-meshes`): four meshes of `../shared/real-meshes` in OFF and
 /// OBJ, edited by scenarios written only in TOML (the knight and the head bust with libigl's own
-/// `.dmat` selections, the bunny with shape selections), every method run on each.
+/// `.dmat` selections, the bunny and the 43K armadillo with shape selections), every method run on
+/// each.
 #[test]
 fn the_real_mesh_suite_runs_from_toml_alone() {
     let Some(_) = support::real_meshes_dir() else { return };
@@ -898,8 +900,8 @@ fn the_real_mesh_suite_runs_from_toml_alone() {
     ];
     assert_eq!(run(&args).unwrap(), std::process::ExitCode::SUCCESS);
     let rows = csv_rows(&reports.path().join("results.csv"));
-    assert_eq!(rows.len(), 3 * methods::registry::METHODS.len());
-    for (scenario, vertices) in [("knight", 502), ("max", 5272), ("bunny", 3485)] {
+    assert_eq!(rows.len(), 4 * methods::registry::METHODS.len());
+    for (scenario, vertices) in [("knight", 502), ("max", 5272), ("bunny", 3485), ("armadillo", 43243)] {
         for row in rows.iter().filter(|r| r["scenario"] == scenario) {
             assert_eq!(row["mesh_source"], "file");
             assert_eq!(row["vertices"], vertices.to_string(), "{scenario}");

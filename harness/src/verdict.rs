@@ -26,6 +26,8 @@ pub struct VerdictRules {
     pub max_handle_residual_over_diag: f64,
     /// A vertex may move at most the largest handle displacement plus this many rest diagonals.
     pub frame_margin_diagonals: f64,
+    /// Largest `turn_beyond_handles_deg` (degrees) that is still `ok`.
+    pub max_turn_beyond_handles_deg: f64,
 }
 
 impl VerdictRules {
@@ -39,6 +41,7 @@ impl VerdictRules {
             ("max_folds", rules.max_folds),
             ("max_handle_residual_over_diag", rules.max_handle_residual_over_diag),
             ("frame_margin_diagonals", rules.frame_margin_diagonals),
+            ("max_turn_beyond_handles_deg", rules.max_turn_beyond_handles_deg),
         ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(config(format!("`{name}` must be a finite number >= 0, not {value}")));
@@ -71,6 +74,13 @@ impl VerdictRules {
             reasons.push(format!(
                 "misses its handles: residual {r:.2e} of the diagonal (> {:.0e})",
                 self.max_handle_residual_over_diag
+            ));
+        }
+        if let Some(t) = quality.get(Metric::TurnBeyondHandles).filter(|t| *t > self.max_turn_beyond_handles_deg) {
+            reasons.push(format!(
+                "turns a free region: a tenth of its free vertices turned {t:.0}° beyond the largest handle turn \
+                 (> {:.0}°)",
+                self.max_turn_beyond_handles_deg
             ));
         }
         let allowed = largest_handle_move + self.frame_margin_diagonals;
@@ -234,7 +244,12 @@ mod tests {
     use super::*;
 
     fn rules() -> VerdictRules {
-        VerdictRules { max_folds: 0.0, max_handle_residual_over_diag: 1e-3, frame_margin_diagonals: 1.0 }
+        VerdictRules {
+            max_folds: 0.0,
+            max_handle_residual_over_diag: 1e-3,
+            frame_margin_diagonals: 1.0,
+            max_turn_beyond_handles_deg: 45.0,
+        }
     }
 
     fn quality(folds: f64, residual: f64) -> Quality {
@@ -257,6 +272,12 @@ mod tests {
         assert!(r.reasons(&quality(0.0, 0.0), 1.19, 0.2).is_empty());
         let left = r.reasons(&quality(0.0, 0.0), 1.21, 0.2);
         assert!(left.len() == 1 && left[0].starts_with("leaves its frame"), "{left:?}");
+        let mut turned = quality(0.0, 0.0);
+        turned.set(Metric::TurnBeyondHandles, Some(44.0));
+        assert!(r.reasons(&turned, 0.3, 0.2).is_empty());
+        turned.set(Metric::TurnBeyondHandles, Some(61.0));
+        let reasons = r.reasons(&turned, 0.3, 0.2);
+        assert!(reasons.len() == 1 && reasons[0].starts_with("turns a free region"), "{reasons:?}");
         let mut q = quality(0.0, 0.0);
         q.set(Metric::EArea, Some(f64::INFINITY));
         let nan = r.reasons(&q, f64::NAN, 0.2);
@@ -310,7 +331,8 @@ mod tests {
         let path = dir.path().join("verdicts.toml");
         std::fs::write(
             &path,
-            "max_folds = -1\nmax_handle_residual_over_diag = 1e-3\nframe_margin_diagonals = 1\n",
+            "max_folds = -1\nmax_handle_residual_over_diag = 1e-3\nframe_margin_diagonals = 1\n\
+             max_turn_beyond_handles_deg = 45\n",
         )
         .unwrap();
         let e = VerdictRules::load(&path).unwrap_err().to_string();
