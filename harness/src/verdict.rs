@@ -78,7 +78,7 @@ impl VerdictRules {
         }
         if let Some(t) = quality.get(Metric::TurnBeyondHandles).filter(|t| *t > self.max_turn_beyond_handles_deg) {
             reasons.push(format!(
-                "turns a free region: a tenth of its free vertices turned {t:.0}° beyond the largest handle turn \
+                "turns a free region: a tenth of its free vertices turned {t:.0}° beyond what the handles ask \
                  (> {:.0}°)",
                 self.max_turn_beyond_handles_deg
             ));
