@@ -210,8 +210,11 @@ fn handle_update_adds_the_constraint_term_to_t1() {
     let omega = 1000.0;
     let size = 4 * model.n_isolines();
     let mut expected = system.smoothness_normal_matrix.clone();
+    // Rows of W act on the positions in the model's frame, (x - c) / l and 1.
+    let frame = model.frame();
     for v in handles.constrained() {
         let x = mesh.positions()[v as usize];
+        let x: [f64; 3] = std::array::from_fn(|a| (x[a] - frame.center[a]) / frame.length);
         let mut row = vec![0.0; size];
         for &(m, w) in model.vertex_weights(v as usize) {
             for (d, h) in [x[0], x[1], x[2], 1.0].into_iter().enumerate() {
