@@ -1009,3 +1009,59 @@ fn mesh_format_and_every_mesh_choose_the_result_files() {
     // f32 rounding: half a unit in the last place, about 6e-8 of the coordinates' size.
     assert!(worst <= 1e-7 * off.bbox_diagonal(), "GLB positions {worst:e} from the OFF ones");
 }
+
+/// Issue 24: a case stopped at its iteration cap is `unfinished` (with where it stopped) in the
+/// CSV and on the page, and the gate fails when a case that was `ok` in the baseline ends so.
+#[test]
+fn a_case_stopped_at_its_cap_is_unfinished_and_the_gate_sees_it() {
+    let scenario = (
+        "bar.toml".to_string(),
+        "name = \"bar\"\nprocedural = { shape = \"bar\", vertices = 600 }\nmethods = [\"arap\", \"laplacian\"]\n"
+            .to_string(),
+    );
+    let configs = configs_with(&[scenario]);
+    let work = tempfile::tempdir().unwrap();
+    let dir = |name: &str| work.path().join(name).to_str().unwrap().to_string();
+    let (config_dir, baseline) = (configs.path().to_str().unwrap(), dir("baseline.json"));
+    let all = |reports: &str| {
+        run(&["all", "--quiet", "--configs", config_dir, "--reports", reports, "--baseline", &baseline])
+            .unwrap()
+    };
+    let first = dir("first");
+    let first_run =
+        run(&["all", "--quiet", "--configs", config_dir, "--reports", &first, "--no-check"]).unwrap();
+    assert_eq!(first_run, std::process::ExitCode::SUCCESS);
+    assert!(csv_rows(&work.path().join("first/results.csv")).iter().all(|r| r["status"] == "ok"));
+    assert_eq!(
+        run(&["baseline", "--reports", &first, "--baseline", &baseline]).unwrap(),
+        std::process::ExitCode::SUCCESS
+    );
+    assert_eq!(all(&dir("same")), std::process::ExitCode::SUCCESS, "the same run passes its own baseline");
+
+    // laplacian capped at 2 iterations: it cannot reach its tolerance.
+    let methods_toml = configs.path().join("methods.toml");
+    let text = std::fs::read_to_string(&methods_toml).unwrap();
+    let (head, tail) = text.split_at(text.find("[laplacian]").unwrap());
+    let capped = format!("{head}{}", tail.replacen("max_iterations = 2000", "max_iterations = 2", 1));
+    assert_ne!(capped, text, "the laplacian cap was found");
+    std::fs::write(&methods_toml, capped).unwrap();
+    let second = dir("second");
+    assert_eq!(all(&second), std::process::ExitCode::from(harness::cli::EXIT_REGRESSION));
+    let rows = csv_rows(&work.path().join("second/results.csv"));
+    let status = |method: &str| rows.iter().find(|r| r["method"] == method).unwrap()["status"].clone();
+    assert_eq!(status("arap"), "ok");
+    let laplacian = status("laplacian");
+    assert!(
+        laplacian.starts_with("unfinished: stopped at the 2-iteration cap, last step ")
+            && laplacian.contains("of the diagonal (tolerance 1e-5)"),
+        "{laplacian}"
+    );
+    let page = std::fs::read_to_string(work.path().join("second/index.html")).unwrap();
+    assert!(
+        page.contains("<tr class=\"unfinished\">") && page.contains("turned unfinished: bar / laplacian")
+    );
+    assert_eq!(
+        run(&["check", "--reports", &second, "--baseline", &baseline]).unwrap(),
+        std::process::ExitCode::from(harness::cli::EXIT_REGRESSION)
+    );
+}

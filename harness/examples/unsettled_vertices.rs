@@ -71,9 +71,11 @@ fn main() -> Result<()> {
         before.iter().zip(&after).enumerate().map(|(i, (p, q))| (norm(sub(*p, *q)) / diagonal, i)).collect();
     steps.sort_by(|a, b| b.0.total_cmp(&a.0));
     for &(s, v) in steps.iter().take(15) {
-        let at: Vec<String> = (0..3).map(|k| format!("{:.2}", (rest[v][k] - lo[k]) / (hi[k] - lo[k]))).collect();
+        let at: Vec<String> =
+            (0..3).map(|k| format!("{:.2}", (rest[v][k] - lo[k]) / (hi[k] - lo[k]))).collect();
         let ring = scenario.topology.one_ring(v);
-        let shortest = ring.iter().map(|&j| norm(sub(rest[j as usize], rest[v]))).fold(f64::INFINITY, f64::min);
+        let shortest =
+            ring.iter().map(|&j| norm(sub(rest[j as usize], rest[v]))).fold(f64::INFINITY, f64::min);
         println!(
             "vertex {v:>6}  step {s:.2e}  at ({})  valence {}  shortest edge {:.1e}  from rest {:.3}",
             at.join(", "),

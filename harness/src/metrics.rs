@@ -575,7 +575,10 @@ pub fn asked_turn(rest: &[[f64; 3]], handles: &HandleSet, targets: &HandleTarget
     for (i, (_, di, si)) in regions.iter().enumerate() {
         for (_, dj, sj) in &regions[i + 1..] {
             let apart = norm(sub(*di, *dj));
-            let gap = si.iter().flat_map(|p| sj.iter().map(move |q| norm(sub(*p, *q)))).fold(f64::INFINITY, f64::min);
+            let gap = si
+                .iter()
+                .flat_map(|p| sj.iter().map(move |q| norm(sub(*p, *q))))
+                .fold(f64::INFINITY, f64::min);
             if apart > 0.0 && gap.is_finite() {
                 bend = bend.max(2.0 * apart.atan2(gap));
             }
@@ -594,7 +597,8 @@ pub fn one_ring_turns(rest: &[[f64; 3]], result: &[[f64; 3]], topology: &Topolog
             if ring.is_empty() {
                 return 0.0;
             }
-            let pairs = ring.iter().map(|&j| (sub(rest[i], rest[j as usize]), sub(result[i], result[j as usize])));
+            let pairs =
+                ring.iter().map(|&j| (sub(rest[i], rest[j as usize]), sub(result[i], result[j as usize])));
             rotation_angle(&covariance(pairs))
         })
         .collect()
@@ -698,8 +702,8 @@ mod tests {
             mesh.n_vertices(),
         )
         .unwrap();
-        let targets = HandleTargets::new(&handles, handles.constrained().map(|v| moved[v as usize]).collect())
-            .unwrap();
+        let targets =
+            HandleTargets::new(&handles, handles.constrained().map(|v| moved[v as usize]).collect()).unwrap();
         Quality::evaluate(&Evaluation::new(
             &rest,
             &mesh,
@@ -748,7 +752,8 @@ mod tests {
         let (mid, top) = (0.5 * (lo[2] + hi[2]), lo[2] + 0.95 * (hi[2] - lo[2]));
         let center = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.0];
         let quarter = AffineTransform::rotation_about([0.0, 0.0, 1.0], std::f64::consts::FRAC_PI_2, center);
-        let turned: Vec<[f64; 3]> = p.iter().map(|&x| if x[2] > mid { quarter.apply(x) } else { x }).collect();
+        let turned: Vec<[f64; 3]> =
+            p.iter().map(|&x| if x[2] > mid { quarter.apply(x) } else { x }).collect();
         let region = |name: &str, keep: &dyn Fn(f64) -> bool| methods::HandleRegion {
             name: name.into(),
             vertices: (0..p.len() as u32).filter(|&v| keep(p[v as usize][2])).collect(),
@@ -757,7 +762,8 @@ mod tests {
         let turn = |regions: Vec<methods::HandleRegion>| {
             let handles = HandleSet::new(regions, p.len()).unwrap();
             let targets =
-                HandleTargets::new(&handles, handles.constrained().map(|v| turned[v as usize]).collect()).unwrap();
+                HandleTargets::new(&handles, handles.constrained().map(|v| turned[v as usize]).collect())
+                    .unwrap();
             let e = Evaluation::new(&rest, &mesh, &topology, &turned, (&handles, &targets), None);
             turn_beyond_handles(&e).to_degrees()
         };

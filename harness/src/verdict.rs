@@ -76,7 +76,9 @@ impl VerdictRules {
                 self.max_handle_residual_over_diag
             ));
         }
-        if let Some(t) = quality.get(Metric::TurnBeyondHandles).filter(|t| *t > self.max_turn_beyond_handles_deg) {
+        if let Some(t) =
+            quality.get(Metric::TurnBeyondHandles).filter(|t| *t > self.max_turn_beyond_handles_deg)
+        {
             reasons.push(format!(
                 "turns a free region: a tenth of its free vertices turned {t:.0}° beyond what the handles ask \
                  (> {:.0}°)",
@@ -289,7 +291,9 @@ mod tests {
         for s in [
             Status::Ok,
             Status::Suspect(vec!["folds: 1%".into(), "misses its handles".into()]),
-            Status::Unfinished(vec!["stopped at the 500-iteration cap, last step 3.0e-4 of the diagonal".into()]),
+            Status::Unfinished(vec![
+                "stopped at the 500-iteration cap, last step 3.0e-4 of the diagonal".into()
+            ]),
             Status::Failed("solver: not positive definite".into()),
         ] {
             assert_eq!(s.to_string().parse::<Status>().unwrap(), s);
@@ -309,7 +313,8 @@ mod tests {
             last_step: 3.04e-4,
             tolerance: Some(1e-5),
         };
-        let s = Status::judge(&[capped], vec!["folds: 0.010% of interior edges turned by more than 90°".into()]);
+        let s =
+            Status::judge(&[capped], vec!["folds: 0.010% of interior edges turned by more than 90°".into()]);
         assert!(s.is_unfinished() && s.kind() == "unfinished");
         assert_eq!(
             s.to_string(),
@@ -317,7 +322,9 @@ mod tests {
              folds: 0.010% of interior edges turned by more than 90°"
         );
         let second = Unfinished { step: 2, steps: 3, iterations: 40, cap: Some(500), ..capped };
-        assert!(second.to_string().starts_with("edit step 2 of 3 stopped after 40 iterations without converging"));
+        assert!(second
+            .to_string()
+            .starts_with("edit step 2 of 3 stopped after 40 iterations without converging"));
         assert_eq!(Status::judge(&[], vec![]), Status::Ok);
         assert!(Status::judge(&[], vec!["x".into()]).is_suspect());
     }

@@ -159,11 +159,7 @@ impl DeformationMethod for LaplacianEditing {
         let normal_matrix = sorted(&product);
         self.cholesky = Some(SparseCholesky::analyze(normal_matrix.as_ref())?);
 
-        let coordinates = RotationInvariantCoordinates::new(
-            positions,
-            &topology,
-            laplacian.as_ref(),
-        );
+        let coordinates = RotationInvariantCoordinates::new(positions, &topology, laplacian.as_ref());
         self.rest = Some(RestState {
             laplacian,
             normal_matrix,

@@ -54,7 +54,14 @@ impl RotationInvariantCoordinates {
         let n = base.len();
         let base_positions = Mat::from_fn(n, 3, |i, a| base[i][a]);
         let mut delta = Mat::zeros(n, 3);
-        sparse_dense_matmul(delta.as_mut(), Accum::Replace, laplacian, base_positions.as_ref(), 1.0, Par::Seq);
+        sparse_dense_matmul(
+            delta.as_mut(),
+            Accum::Replace,
+            laplacian,
+            base_positions.as_ref(),
+            1.0,
+            Par::Seq,
+        );
         let mut offsets = Vec::with_capacity(n + 1);
         let mut neighbors = Vec::new();
         let mut base_edges = Vec::new();

@@ -34,8 +34,12 @@ fn acceleration_reaches_the_plain_fixed_point() {
     let mut failures = Vec::new();
     // hirm's plain iteration jitters at steps of 2-3e-8 diagonals (20000 iterations), so it is run
     // to 1e-7.
-    let methods =
-        [(registry::LAPLACIAN, 1e-10), (registry::ISOLINES, 1e-10), (registry::ISOLINES_T1, 1e-10), (registry::HIRM, 1e-7)];
+    let methods = [
+        (registry::LAPLACIAN, 1e-10),
+        (registry::ISOLINES, 1e-10),
+        (registry::ISOLINES_T1, 1e-10),
+        (registry::HIRM, 1e-7),
+    ];
     for (name, tolerance) in methods {
         let (plain, plain_shape) = run(name, "none", tolerance);
         let (accelerated, accelerated_shape) = run(name, "anderson", tolerance);

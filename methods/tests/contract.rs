@@ -367,7 +367,8 @@ fn scaling_or_moving_the_whole_scene_gives_the_same_relative_result() {
             worst = worst.max(d);
             lines.push(format!("{name} {d:.1e}"));
         }
-        within(worst, invariance_tolerance(entry.name)).map(|line| format!("{line} ({})", lines.join(", ")))
+        within(worst, invariance_tolerance(entry.name))
+            .map(|line| format!("{line} ({})", lines.join(", ")))
             .map_err(|line| format!("{line} ({})", lines.join(", ")))
     });
 }

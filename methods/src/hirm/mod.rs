@@ -456,8 +456,11 @@ impl DeformationMethod for Hirm {
         let tolerance = self.params.tolerance;
         let iterations = Iterations { first: 0, count: self.params.max_iterations, tolerance };
         let factor = self.normal_factor.as_ref();
-        let mut fixed_point =
-            ReducedFixedPoint::new(self.params.acceleration, self.params.anderson_depth, self.reduced.nrows());
+        let mut fixed_point = ReducedFixedPoint::new(
+            self.params.acceleration,
+            self.params.anderson_depth,
+            self.reduced.nrows(),
+        );
         let iterate = |reduced: &mut Mat<f64>, iteration: usize| -> Result<f64, MethodError> {
             fixed_point.begin(reduced.as_ref());
             // Eq 17-19, then eq 20 (eq 27 with T_2 = W^T L^T W_sigma R_sigma).

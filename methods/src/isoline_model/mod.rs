@@ -130,7 +130,11 @@ impl ReducedFixedPoint {
             unflatten(&self.x, reduced.as_mut());
             let next = model.probe_positions(reduced.as_ref());
             if let Some(i) = next.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-                return Err(MethodError::NonFinite { method, vertex: model.probe_vertex(i) as usize, iteration });
+                return Err(MethodError::NonFinite {
+                    method,
+                    vertex: model.probe_vertex(i) as usize,
+                    iteration,
+                });
             }
             *probes = next;
         }

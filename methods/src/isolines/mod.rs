@@ -64,8 +64,8 @@ use crate::isoline_model::{
     checked_positions, reduced_step, IsolineModel, ModelFrame, ReducedFixedPoint, ReducedIteration,
     ReducedSystem, RotationFit, SetBlend,
 };
-use crate::linalg::anderson::{Acceleration, MAX_DEPTH};
 use crate::laplacian_coordinates::RotationInvariantCoordinates;
+use crate::linalg::anderson::{Acceleration, MAX_DEPTH};
 use crate::method::{run_iterations, DeformationMethod, IterationObserver, Iterations, SolveSummary};
 use crate::operators::{laplacian, LaplacianWeights};
 
@@ -259,11 +259,7 @@ impl DeformationMethod for Isolines {
             MethodError::Solver(crate::linalg::sparse_cholesky::SolverError::NotPositiveDefinite)
         })?;
         let coordinates = (self.params.laplacian_coordinates == LaplacianCoordinates::Vertices).then(|| {
-            RotationInvariantCoordinates::new(
-                &self.current,
-                &rest.topology,
-                rest.laplacian.as_ref(),
-            )
+            RotationInvariantCoordinates::new(&self.current, &rest.topology, rest.laplacian.as_ref())
         });
         let t3 = Instant::now();
         self.reduced = model.identity_transforms();
@@ -295,8 +291,11 @@ impl DeformationMethod for Isolines {
         let setup = t0.elapsed().as_secs_f64();
         let tolerance = self.params.tolerance;
         let iterations = Iterations { first: 0, count: self.params.max_iterations, tolerance };
-        let mut fixed_point =
-            ReducedFixedPoint::new(self.params.acceleration, self.params.anderson_depth, self.reduced.nrows());
+        let mut fixed_point = ReducedFixedPoint::new(
+            self.params.acceleration,
+            self.params.anderson_depth,
+            self.reduced.nrows(),
+        );
         let iterate = |reduced: &mut Mat<f64>, iteration: usize| -> Result<f64, MethodError> {
             fixed_point.begin(reduced.as_ref());
             let mut rhs = constraint_rhs.clone();

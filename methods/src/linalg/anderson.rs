@@ -38,7 +38,12 @@ impl FixedPointIteration {
     /// For iterates of `dimension` entries: Anderson acceleration of depth `depth` (history dropped
     /// when the residual grows by more than `residual_growth_limit` in one step) when `acceleration`
     /// asks for it and `depth > 0`, else the plain iteration.
-    pub fn new(acceleration: Acceleration, depth: usize, dimension: usize, residual_growth_limit: f64) -> Self {
+    pub fn new(
+        acceleration: Acceleration,
+        depth: usize,
+        dimension: usize,
+        residual_growth_limit: f64,
+    ) -> Self {
         let accelerated = acceleration == Acceleration::Anderson && depth > 0;
         Self {
             anderson: accelerated.then(|| {
