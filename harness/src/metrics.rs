@@ -10,6 +10,7 @@ use std::fmt;
 use meshes::geometry::{corner_angles, dihedral_angles, edge_lengths, face_areas, signed_volume};
 use meshes::vector::{norm, sub};
 use meshes::{Topology, TriMesh};
+use methods::rotation_fit::{closest_rotation, cross_covariance, rotation_angle};
 use methods::{HandleSet, HandleTargets};
 use serde::de::{IgnoredAny, MapAccess, Visitor};
 use serde::ser::SerializeMap;
@@ -599,7 +600,7 @@ pub fn one_ring_turns(rest: &[[f64; 3]], result: &[[f64; 3]], topology: &Topolog
             }
             let pairs =
                 ring.iter().map(|&j| (sub(rest[i], rest[j as usize]), sub(result[i], result[j as usize])));
-            rotation_angle(&covariance(pairs))
+            turn_of(&cross_covariance(pairs))
         })
         .collect()
 }
@@ -622,26 +623,12 @@ pub fn region_turn(pairs: &[([f64; 3], [f64; 3])]) -> f64 {
         c
     };
     let (c0, c1) = (centroid(|p| p.0), centroid(|p| p.1));
-    rotation_angle(&covariance(pairs.iter().map(|(p, q)| (sub(*p, c0), sub(*q, c1)))))
+    turn_of(&cross_covariance(pairs.iter().map(|(p, q)| (sub(*p, c0), sub(*q, c1)))))
 }
 
-/// `sum (to)(from)^T` over `(from, to)` vector pairs.
-fn covariance(pairs: impl Iterator<Item = ([f64; 3], [f64; 3])>) -> [[f64; 3]; 3] {
-    let mut m = [[0.0; 3]; 3];
-    for (from, to) in pairs {
-        for a in 0..3 {
-            for b in 0..3 {
-                m[a][b] += to[a] * from[b];
-            }
-        }
-    }
-    m
-}
-
-/// The angle of the rotation closest to `m` (radians, in `[0, pi]`).
-fn rotation_angle(m: &[[f64; 3]; 3]) -> f64 {
-    let r = methods::rotation_fit::closest_rotation(m);
-    ((r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0).clamp(-1.0, 1.0).acos()
+/// The angle (radians, in `[0, pi]`) of the rotation closest to the cross-covariance `m`.
+fn turn_of(m: &[[f64; 3]; 3]) -> f64 {
+    rotation_angle(&closest_rotation(m))
 }
 
 /// Root-mean-square vertex distance between two `#V x 3` position arrays, divided by `diagonal`.

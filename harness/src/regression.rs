@@ -2,8 +2,9 @@
 //! for runs on the survey meshes, `reports/baselines/procedural.json` for the procedural look-alikes)
 //! holds the verdict and every gated measure of the metric table ([`crate::metrics::METRICS`]) of
 //! each (scenario, method). [`check`] compares a run against it and names every measure that got
-//! worse beyond its tolerance, every case that turned suspect or unfinished, failed or produced a non-finite
-//! measure, and every baseline case the run lacks. Improvements pass (and are listed, so the
+//! worse beyond its tolerance, every case whose status got worse (ok -> suspect or unfinished,
+//! suspect -> unfinished), failed or produced a non-finite measure, and every baseline case the run
+//! lacks. Improvements pass (and are listed, so the
 //! baseline can be renewed on purpose with `harness baseline`).
 
 use std::collections::BTreeMap;

@@ -110,6 +110,14 @@ pub struct Unfinished {
     pub tolerance: Option<f64>,
 }
 
+impl Unfinished {
+    /// Whether `reason` (of an `unfinished` status) is the text of an [`Unfinished`], not a reason
+    /// of the shape: what its `Display` starts with.
+    fn wrote(reason: &str) -> bool {
+        reason.starts_with("stopped ") || reason.starts_with("edit step ")
+    }
+}
+
 impl fmt::Display for Unfinished {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         if self.steps > 1 {
@@ -170,17 +178,15 @@ impl Status {
         }
     }
 
-    /// The reasons of a suspect or unfinished case (empty otherwise).
-    pub fn reasons(&self) -> &[String] {
-        match self {
-            Status::Suspect(r) | Status::Unfinished(r) => r,
-            _ => &[],
-        }
-    }
-
-    /// `Ok` for no reasons, else `Suspect`.
-    pub fn from_reasons(reasons: Vec<String>) -> Status {
-        Status::judge(&[], reasons)
+    /// The reasons to distrust the shape itself: every reason of a suspect case, those after the
+    /// unfinished steps of an unfinished one, none otherwise.
+    pub fn shape_reasons(&self) -> impl Iterator<Item = &String> {
+        let (reasons, skip_unfinished): (&[String], bool) = match self {
+            Status::Suspect(r) => (r, false),
+            Status::Unfinished(r) => (r, true),
+            _ => (&[], false),
+        };
+        reasons.iter().filter(move |r| !(skip_unfinished && Unfinished::wrote(r)))
     }
 
     /// The status of a case that produced a shape: `Unfinished` when any step did not finish (its
@@ -321,7 +327,12 @@ mod tests {
             "unfinished: stopped at the 500-iteration cap, last step 3.0e-4 of the diagonal (tolerance 1e-5); \
              folds: 0.010% of interior edges turned by more than 90°"
         );
+        assert_eq!(s.shape_reasons().count(), 1, "the fold, not the cap");
         let second = Unfinished { step: 2, steps: 3, iterations: 40, cap: Some(500), ..capped };
+        let both = Status::judge(&[capped, second], vec![]);
+        assert_eq!(both.shape_reasons().count(), 0, "{both}");
+        let parsed: Status = both.to_string().parse().unwrap();
+        assert_eq!(parsed.shape_reasons().count(), 0, "read back from results.json");
         assert!(second
             .to_string()
             .starts_with("edit step 2 of 3 stopped after 40 iterations without converging"));

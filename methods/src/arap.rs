@@ -51,7 +51,7 @@ use serde::Deserialize;
 
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets, FREE};
-use crate::linalg::anderson::AndersonAcceleration;
+use crate::linalg::anderson::{Acceleration, AndersonAcceleration, RESIDUAL_GROWTH_LIMIT};
 use crate::linalg::sparse_cholesky::SparseCholesky;
 use crate::method::{
     move_to, run_iterations, DeformationMethod, IterationObserver, Iterations, SolveSummary,
@@ -70,21 +70,10 @@ pub struct ArapParams {
     /// Spokes, weights and global-step matrix (see the module documentation, "Weights").
     pub weights: LaplacianWeights,
     /// `"anderson"` (Peng et al. 2018) or `"none"` (the plain local/global iteration, libigl's).
-    pub acceleration: ArapAcceleration,
+    pub acceleration: Acceleration,
     /// Steps of history Anderson acceleration extrapolates from (`m` of Peng et al.; at most 16).
     pub anderson_depth: usize,
 }
-
-/// Anderson's history is also dropped when the plain residual more than doubles in one step. The
-/// energy test alone let the bar wander to the 1000-iteration cap; dropping it at any growth (as
-/// `scale_aware` does) held the cactus at 586 iterations. Survey, iterations to tolerance 1e-5 with
-/// depth 7 (plain: cylinder 1182, bar 2417, cactus 1468, plane 2210): 280, 175, 239, 388.
-const RESIDUAL_GROWTH_LIMIT: f64 = 2.0;
-
-/// How the local/global iteration is driven (see the module documentation, "Acceleration"):
-/// `None` is the plain alternation of Sorkine & Alexa 2007 and libigl's `arap_solve`; `Anderson`
-/// adds the energy safeguard of Peng et al. 2018.
-pub use crate::linalg::anderson::Acceleration as ArapAcceleration;
 
 impl Default for ArapParams {
     fn default() -> Self {
@@ -92,7 +81,7 @@ impl Default for ArapParams {
             max_iterations: 1000,
             tolerance: 1e-5,
             weights: LaplacianWeights::default(),
-            acceleration: ArapAcceleration::default(),
+            acceleration: Acceleration::default(),
             anderson_depth: 7,
         }
     }
@@ -335,7 +324,7 @@ impl DeformationMethod for Arap {
         }
         let region_of = handles.region_of();
         let accelerated =
-            self.params.acceleration == ArapAcceleration::Anderson && self.params.anderson_depth > 0;
+            self.params.acceleration == Acceleration::Anderson && self.params.anderson_depth > 0;
         let mut anderson = AndersonAcceleration::new(
             if accelerated { self.params.anderson_depth } else { 0 },
             if accelerated { 3 * self.current.len() } else { 0 },

@@ -66,6 +66,25 @@ pub fn closest_rotation_warm(m: &Mat3, frame: &mut Mat3) -> Mat3 {
     r
 }
 
+/// `sum_k to_k from_k^T` over `(from, to)` vector pairs, in their order: the matrix whose
+/// [`closest_rotation`] best maps the `from` vectors onto the `to` ones.
+pub fn cross_covariance(pairs: impl IntoIterator<Item = ([f64; 3], [f64; 3])>) -> Mat3 {
+    let mut m = [[0.0; 3]; 3];
+    for (from, to) in pairs {
+        for a in 0..3 {
+            for b in 0..3 {
+                m[a][b] += to[a] * from[b];
+            }
+        }
+    }
+    m
+}
+
+/// The angle of the rotation `r` about its axis (radians, in `[0, pi]`).
+pub fn rotation_angle(r: &Mat3) -> f64 {
+    ((r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0).clamp(-1.0, 1.0).acos()
+}
+
 /// The singular values of `m`, descending (square roots of the eigenvalues of `m^T m`).
 pub fn singular_values(m: &Mat3) -> [f64; 3] {
     let mtm: Mat3 = std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| m[k][i] * m[k][j]).sum()));
@@ -75,7 +94,8 @@ pub fn singular_values(m: &Mat3) -> [f64; 3] {
     s
 }
 
-const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// The 3x3 identity.
+pub const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 /// Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations: `(eigenvalues, V)` with
 /// the eigenvectors in the columns of `V`.

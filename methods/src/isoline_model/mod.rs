@@ -86,19 +86,17 @@ pub(crate) fn reduced_step(
 /// of `#V`.
 pub(crate) struct ReducedFixedPoint {
     iteration: FixedPointIteration,
-    /// `R` before the step and `T(R)`, flattened column by column.
+    /// `R` before the step and `T(R)`, flattened column by column (`g` is the last image, which an
+    /// unconverged solve returns).
     x: Vec<f64>,
     g: Vec<f64>,
 }
-
-/// Anderson's history is dropped when the plain step more than doubles in one iteration (as `arap`).
-const RESIDUAL_GROWTH_LIMIT: f64 = 2.0;
 
 impl ReducedFixedPoint {
     /// For `reduced` transforms of `rows x 3`.
     pub fn new(acceleration: Acceleration, depth: usize, rows: usize) -> Self {
         let dimension = 3 * rows;
-        let iteration = FixedPointIteration::new(acceleration, depth, dimension, RESIDUAL_GROWTH_LIMIT);
+        let iteration = FixedPointIteration::new(acceleration, depth, dimension);
         let buffers = if iteration.is_accelerated() { dimension } else { 0 };
         Self { iteration, x: vec![0.0; buffers], g: vec![0.0; buffers] }
     }
@@ -144,7 +142,7 @@ impl ReducedFixedPoint {
     /// After a solve that ended unconverged: the last `T(R)` into `reduced` (not an extrapolation).
     pub fn end_unconverged(&self, reduced: &mut Mat<f64>) {
         if self.iteration.is_accelerated() {
-            unflatten(self.iteration.last_image(), reduced.as_mut());
+            unflatten(&self.g, reduced.as_mut());
         }
     }
 }

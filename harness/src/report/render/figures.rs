@@ -382,7 +382,7 @@ fn grid_image(
                     if case.is_some_and(|c| c.status.is_unfinished()) {
                         marks.push(("unfinished: stopped at its cap", UNFINISHED_INK));
                     }
-                    if case.is_some_and(|c| c.status.is_suspect() || c.status.reasons().len() > 1) {
+                    if case.is_some_and(|c| c.status.shape_reasons().next().is_some()) {
                         marks.push(("suspect", SUSPECT_INK));
                     }
                     if let Some((_, color)) = marks.first() {
