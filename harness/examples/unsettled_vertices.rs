@@ -26,8 +26,12 @@ struct LastTwo {
 }
 
 impl IterationObserver for LastTwo {
-    fn on_iteration(&mut self, r: &IterationReport, shape: &dyn Fn() -> Vec<[f64; 3]>) -> ControlFlow<()> {
-        if r.iteration + 2 >= self.cap {
+    fn on_iteration(
+        &mut self,
+        r: &IterationReport,
+        shape: Option<&dyn Fn() -> Vec<[f64; 3]>>,
+    ) -> ControlFlow<()> {
+        if let (true, Some(shape)) = (r.iteration + 2 >= self.cap, shape) {
             self.previous = self.last.take();
             self.last = Some(shape());
         }

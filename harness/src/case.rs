@@ -6,6 +6,7 @@ use std::time::Instant;
 use methods::{IterationObserver, IterationReport};
 use serde::{Deserialize, Serialize};
 
+use crate::config::{ConfiguredMethod, Origin};
 use crate::metrics::{angle_errors, largest_displacement, Evaluation, Metric, Quality, RestGeometry};
 use crate::scenario::LoadedScenario;
 use crate::verdict::{Status, Unfinished, VerdictRules};
@@ -79,12 +80,22 @@ pub struct StepRecord {
 pub struct CaseResult {
     pub scenario: String,
     pub method: String,
+    /// Built-in, external or peer.
+    #[serde(default)]
+    pub origin: Origin,
+    /// What ran, in an external method's own words (its library and version), if it said.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub about: Option<String>,
     pub mesh_source: String,
     pub vertices: usize,
     pub faces: usize,
     /// The Laplacian weights the method ran with (`weights` in configs/methods.toml).
     #[serde(default)]
     pub laplacian_weights: String,
+    /// An external method's process start-up and handshake (NaN for a built-in method): not part of
+    /// `precompute_s`.
+    #[serde(default = "nan", deserialize_with = "nan_from_null")]
+    pub startup_s: f64,
     #[serde(deserialize_with = "nan_from_null")]
     pub precompute_s: f64,
     #[serde(deserialize_with = "nan_from_null")]
@@ -149,7 +160,11 @@ struct Recorder<'a> {
 }
 
 impl IterationObserver for Recorder<'_> {
-    fn on_iteration(&mut self, r: &IterationReport, shape: &dyn Fn() -> Vec<[f64; 3]>) -> ControlFlow<()> {
+    fn on_iteration(
+        &mut self,
+        r: &IterationReport,
+        shape: Option<&dyn Fn() -> Vec<[f64; 3]>>,
+    ) -> ControlFlow<()> {
         let mut record = IterationRecord {
             edit_step: self.edit_step,
             iteration: r.iteration,
@@ -158,7 +173,7 @@ impl IterationObserver for Recorder<'_> {
             e_theta_deg: None,
             e_phi_deg: None,
         };
-        if records_quality(r.iteration) {
+        if let (true, Some(shape)) = (records_quality(r.iteration), shape) {
             let t = Instant::now();
             let (e_theta, e_phi) =
                 angle_errors(self.rest, &self.scenario.mesh, &self.scenario.topology, &shape());
@@ -182,31 +197,38 @@ pub enum Reference<'a> {
     Missing,
 }
 
-/// Run `method` (with its parameter table) on `scenario`, measure the result against `rest` (the
-/// scenario's rest geometry) and `reference`, and judge it by `rules`. A method error becomes a
-/// `failed` result; it does not abort the run.
+/// Run `method` (a fresh instance; an external method's stderr goes to `stderr_log`) on
+/// `scenario`, measure the result against `rest` (the scenario's rest geometry) and `reference`,
+/// and judge it by `rules`. A method error becomes a `failed` result; it does not abort the run.
 pub fn run_case(
     scenario: &LoadedScenario,
     rest: &RestGeometry,
-    method: &str,
-    params: &toml::Table,
+    method: &ConfiguredMethod,
+    stderr_log: Option<std::path::PathBuf>,
     rules: &VerdictRules,
     reference: Reference<'_>,
 ) -> CaseResult {
+    let params = &method.params;
     let mut result = CaseResult::empty(
         &scenario.spec.name,
-        method,
+        &method.name,
         &scenario.mesh_source,
         scenario.mesh.n_vertices(),
         scenario.mesh.n_faces(),
     );
-    result.laplacian_weights = laplacian_weights(params);
+    result.origin = method.origin;
+    result.laplacian_weights = match method.origin {
+        Origin::BuiltIn => laplacian_weights(params),
+        Origin::External | Origin::Peer => String::new(),
+    };
     let mut recorder = Recorder { scenario, rest, trace: Vec::new(), edit_step: 0, quality_s: 0.0 };
     let mut unfinished = Vec::new();
     let cap = params.get("max_iterations").and_then(toml::Value::as_integer).map(|c| c as usize);
     let tolerance = params.get("tolerance").and_then(toml::Value::as_float);
     let outcome = (|| -> Result<Vec<String>, methods::MethodError> {
-        let mut m = methods::registry::create(method, params)?;
+        let mut m = method.create(stderr_log)?;
+        result.startup_s = m.startup_seconds().unwrap_or(f64::NAN);
+        result.about = m.about();
         let start = Instant::now();
         m.precompute(&scenario.mesh)?;
         result.precompute_s = start.elapsed().as_secs_f64();
@@ -250,7 +272,7 @@ pub fn run_case(
                 converged: summary.converged,
                 final_step: summary.final_step,
                 median_iteration_ms: median_ms(&recorder.trace[first_iteration..]),
-                phase_timings: m.phase_timings().into_iter().map(|(k, v)| (k.to_string(), v)).collect(),
+                phase_timings: m.phase_timings(),
             });
             final_edit = Some((step, targets));
         }
@@ -259,15 +281,11 @@ pub fn run_case(
         result.bind_s = result.steps.first().map_or(f64::NAN, |s| s.bind_s);
         result.solve_s = solve_s;
         result.total_s = start.elapsed().as_secs_f64() - recorder.quality_s;
-        result.phase_timings = m.phase_timings().into_iter().map(|(k, v)| (k.to_string(), v)).collect();
-        result.statistics = m.model_statistics().into_iter().map(|(k, v)| (k.to_string(), v)).collect();
+        result.phase_timings = m.phase_timings();
+        result.statistics = m.model_statistics();
         let (step, targets) = final_edit.expect("a scenario has at least one step");
         if let Some(v) = positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-            return Err(methods::MethodError::NonFinite {
-                method: m.name(),
-                vertex: v,
-                iteration: result.iterations,
-            });
+            return Err(methods::MethodError::NonFiniteResult { method: m.name().to_string(), vertex: v });
         }
         let evaluation_start = Instant::now();
         let reference = match reference {
@@ -328,10 +346,13 @@ impl CaseResult {
         CaseResult {
             scenario: scenario.to_string(),
             method: method.to_string(),
+            origin: Origin::BuiltIn,
+            about: None,
             mesh_source: mesh_source.to_string(),
             vertices,
             faces,
             laplacian_weights: String::new(),
+            startup_s: f64::NAN,
             precompute_s: f64::NAN,
             bind_s: f64::NAN,
             median_iteration_ms: f64::NAN,

@@ -98,16 +98,41 @@ enum Command {
 
 #[derive(Args, Clone)]
 struct Peers {
+    /// Add the peer libraries' methods of configs/peers.toml (libigl's ARAP and biharmonic
+    /// deformation, open3d's ARAP) to every scenario that does not restrict its methods. They run
+    /// in the cross-check Python (--python); without it the run says that peers were not run.
+    #[arg(long)]
+    peers: bool,
     /// Check every result of up to 100K faces for self-intersections with open3d (slow on large
     /// meshes: ~25 s per result on the bumpy plane) and report it in the `self_intersecting` column.
     #[arg(long)]
     self_intersections: bool,
-    /// The cross-check Python with open3d (`scripts/python-env` prints it).
+    /// The cross-check Python with libigl and open3d (`scripts/python-env` prints it).
     #[arg(long, env = peers::PYTHON_ENV)]
     python: Option<PathBuf>,
 }
 
 impl Peers {
+    /// The peer methods' file when `--peers` was given and the Python is there (it is exported as
+    /// DEFORMBENCH_PYTHON for their commands); `Err` says why peers are not run.
+    fn peer_methods(&self, configs_dir: &std::path::Path) -> Option<Result<PathBuf, String>> {
+        if !self.peers {
+            return None;
+        }
+        Some(match &self.python {
+            Some(p) if p.is_file() => {
+                std::env::set_var(peers::PYTHON_ENV, p);
+                Ok(configs_dir.join("peers.toml"))
+            }
+            Some(p) => Err(format!("peers not run: the Python {} does not exist", p.display())),
+            None => Err(format!(
+                "peers not run: they need the cross-check Python with libigl and open3d; give --python or set {} \
+                 (scripts/python-env sets it up and prints its path)",
+                peers::PYTHON_ENV
+            )),
+        })
+    }
+
     /// The Python to run the peer checks with, if they were asked for.
     fn python(&self) -> anyhow::Result<Option<PathBuf>> {
         if !self.self_intersections {
@@ -181,6 +206,7 @@ impl Common {
             survey_dir: self.survey_dir.clone(),
             scenarios,
             methods,
+            peers: None,
             progress: !self.quiet,
         }
     }
@@ -203,7 +229,8 @@ where
     let cli = Cli::parse_from(args);
     match cli.command {
         Command::All { common, peers, meshes, gate, no_check, shard } => {
-            let options = common.options(Vec::new(), Vec::new());
+            let mut options = common.options(Vec::new(), Vec::new());
+            let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             if let Some(shard) = shard {
                 return run_shard(&options, shard);
             }
@@ -213,7 +240,8 @@ where
                 GateRequest::for_suite(&options, gate.baseline)
             };
             let publish = PublishOptions { peer_python: peers.python()?, meshes: meshes.output() };
-            let run = suite::run(&options).context("preparing the run")?;
+            let mut run = suite::run(&options).context("preparing the run")?;
+            run.notes.extend(skipped_peers);
             publish_and_print(&options, run, &publish, gate)
         }
         Command::Merge { partials, common, meshes, gate } => {
@@ -224,9 +252,11 @@ where
             publish_and_print(&options, run, &publish, gate)
         }
         Command::Run { methods, scenario, common, peers, meshes } => {
-            let options = common.options(vec![scenario], methods);
+            let mut options = common.options(vec![scenario], methods);
+            let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             let publish = PublishOptions { peer_python: peers.python()?, meshes: meshes.output() };
-            let run = suite::run(&options).context("preparing the run")?;
+            let mut run = suite::run(&options).context("preparing the run")?;
+            run.notes.extend(skipped_peers);
             publish_and_print(
                 &options,
                 run,
@@ -249,9 +279,15 @@ where
         }
         Command::List(common) => {
             let options = common.options(Vec::new(), Vec::new());
-            println!("methods:");
-            for m in methods::registry::METHODS {
-                println!("  {:<14} {}", m.name, m.summary);
+            println!("methods ({}):", options.configs_dir.join("methods.toml").display());
+            let catalog = suite::load_catalog(&options)?;
+            for m in catalog.methods() {
+                let origin = if m.origin == crate::config::Origin::BuiltIn {
+                    String::new()
+                } else {
+                    format!("[{}] ", m.origin.label())
+                };
+                println!("  {:<14} {origin}{}", m.name, m.summary());
             }
             println!("scenarios ({}):", options.configs_dir.join("scenarios").display());
             for s in load_specs(&options.configs_dir.join("scenarios"))? {

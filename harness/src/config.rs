@@ -1,51 +1,335 @@
-//! Method parameters: one TOML file (`configs/methods.toml`) with a table per method holding the
-//! papers' defaults. Unknown method names and unknown keys are errors that name the file.
+//! The methods of a run, as configured: `configs/methods.toml` holds a table per method, either the
+//! parameters of a built-in method (missing keys take the papers' defaults) or an external program
+//! (`command`, see [`ExternalEntry`]); `configs/peers.toml`, in the same format, holds the peer
+//! libraries' adapters that `--peers` adds. Unknown names and keys are errors that name the file.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use serde::{Deserialize, Serialize};
 
 use crate::error::HarnessError;
+use methods::external::{ExternalMethod, ExternalSpec};
+use methods::{DeformationMethod, MethodError};
 
-/// Parameter tables by method name, as read from `configs/methods.toml`.
-#[derive(Clone, Debug, Default)]
-pub struct MethodParams {
-    path: PathBuf,
-    tables: BTreeMap<String, toml::Table>,
+/// Where a method's implementation comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Origin {
+    /// One of this suite's own methods ([`methods::registry::METHODS`]).
+    #[default]
+    BuiltIn,
+    /// A program named in `configs/methods.toml`, spoken to over the protocol.
+    External,
+    /// A peer library's method (`configs/peers.toml`, added by `--peers`), external too.
+    Peer,
 }
 
-impl MethodParams {
-    /// Read and check `path`: every top-level key must be a registered method with a table of
-    /// parameters that the method accepts.
+impl Origin {
+    /// The word in tables and on the page.
+    pub fn label(self) -> &'static str {
+        match self {
+            Origin::BuiltIn => "built-in",
+            Origin::External => "external",
+            Origin::Peer => "peer",
+        }
+    }
+}
+
+/// The keys of an external method's table; everything else is an error (its own parameters go in
+/// its `params` table).
+const EXTERNAL_KEYS: &[&str] = &["command", "working_dir", "timeout_s", "summary", "params"];
+
+/// An external method's entry, resolved: `command = ["program", "arg", …]` with `${VAR}` expanded,
+/// `working_dir` (relative to the file's directory; default that directory), `timeout_s` per
+/// request, a one-line `summary`, and `params`, sent to the program untouched.
+#[derive(Clone, Debug)]
+pub struct ExternalEntry {
+    pub program: String,
+    pub args: Vec<String>,
+    pub working_dir: PathBuf,
+    pub timeout: Duration,
+    pub summary: String,
+    pub params: serde_json::Value,
+}
+
+/// One method of a run.
+#[derive(Clone, Debug)]
+pub struct ConfiguredMethod {
+    pub name: String,
+    pub origin: Origin,
+    /// A built-in method's parameters (its table); an external method's `params`.
+    pub params: toml::Table,
+    /// How to run it, for an external method.
+    pub external: Option<ExternalEntry>,
+}
+
+impl ConfiguredMethod {
+    /// A fresh instance; an external method's program is started (its stderr appended to
+    /// `stderr_log`).
+    pub fn create(&self, stderr_log: Option<PathBuf>) -> Result<Box<dyn DeformationMethod>, MethodError> {
+        match &self.external {
+            None => methods::registry::create(&self.name, &self.params),
+            Some(e) => Ok(Box::new(ExternalMethod::start(ExternalSpec {
+                name: self.name.clone(),
+                program: e.program.clone(),
+                args: e.args.clone(),
+                working_dir: Some(e.working_dir.clone()),
+                env: Vec::new(),
+                timeout: e.timeout,
+                params: e.params.clone(),
+                stderr_log,
+            })?)),
+        }
+    }
+
+    /// One line: what it is.
+    pub fn summary(&self) -> &str {
+        match &self.external {
+            None => methods::registry::find(&self.name).map_or("", |m| m.summary),
+            Some(e) => &e.summary,
+        }
+    }
+}
+
+/// Every method a run can use: the built-in ones in registry order, then the external ones of
+/// `methods.toml` in file order, then the peers when asked for.
+#[derive(Clone, Debug, Default)]
+pub struct MethodCatalog {
+    path: PathBuf,
+    methods: Vec<ConfiguredMethod>,
+}
+
+impl MethodCatalog {
+    /// Read and check `path` (`configs/methods.toml`): every top-level key is a built-in method with
+    /// parameters it accepts, or an external method with a `command`.
     pub fn load(path: &Path) -> Result<Self, HarnessError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
-        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| HarnessError::Config {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
-        let mut tables = BTreeMap::new();
-        for (name, value) in table {
-            let toml::Value::Table(params) = value else {
+        let mut methods: Vec<ConfiguredMethod> = methods::registry::METHODS
+            .iter()
+            .map(|m| ConfiguredMethod {
+                name: m.name.to_string(),
+                origin: Origin::BuiltIn,
+                params: toml::Table::new(),
+                external: None,
+            })
+            .collect();
+        for (name, table) in read_tables(path)? {
+            let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
+            if table.contains_key("command") {
+                if methods.iter().any(|m| m.name == name) {
+                    return Err(config(format!(
+                        "`{name}` is a built-in method; an external one needs another name"
+                    )));
+                }
+                methods.push(external(path, &name, &table, Origin::External)?);
+            } else {
+                // Building the method validates the name and every key.
+                methods::registry::create(&name, &table).map_err(|e| config(e.to_string()))?;
+                let entry = methods.iter_mut().find(|m| m.name == name).expect("a registered method");
+                entry.params = table;
+            }
+        }
+        Ok(Self { path: path.to_path_buf(), methods })
+    }
+
+    /// Add the external methods of `path` (`configs/peers.toml`) as peers.
+    pub fn add_peers(&mut self, path: &Path) -> Result<(), HarnessError> {
+        for (name, table) in read_tables(path)? {
+            if self.methods.iter().any(|m| m.name == name) {
                 return Err(HarnessError::Config {
                     path: path.to_path_buf(),
-                    message: format!("`{name}` must be a table of parameters, e.g. [{name}]"),
+                    message: format!("peer `{name}` has the name of a method of {}", self.path.display()),
                 });
-            };
-            // Building the method validates the name and every key.
-            methods::registry::create(&name, &params)
-                .map_err(|e| HarnessError::Config { path: path.to_path_buf(), message: e.to_string() })?;
-            tables.insert(name, params);
+            }
+            self.methods.push(external(path, &name, &table, Origin::Peer)?);
         }
-        Ok(Self { path: path.to_path_buf(), tables })
+        Ok(())
     }
 
-    /// Parameters of `method` (empty: the method's built-in defaults).
-    pub fn get(&self, method: &str) -> toml::Table {
-        self.tables.get(method).cloned().unwrap_or_default()
+    /// The method called `name`.
+    pub fn get(&self, name: &str) -> Option<&ConfiguredMethod> {
+        self.methods.iter().find(|m| m.name == name)
     }
 
-    /// The file these parameters came from.
+    /// The method called `name`, or an error listing the known names.
+    pub fn find(&self, name: &str) -> Result<&ConfiguredMethod, String> {
+        self.get(name).ok_or_else(|| {
+            format!("unknown method `{name}`; known methods: {}", self.names().collect::<Vec<_>>().join(", "))
+        })
+    }
+
+    /// Every method, in report order.
+    pub fn methods(&self) -> &[ConfiguredMethod] {
+        &self.methods
+    }
+
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.methods.iter().map(|m| m.name.as_str())
+    }
+
+    /// The file the methods came from.
     pub fn path(&self) -> &Path {
         &self.path
+    }
+}
+
+/// The top-level tables of `path`, in file order.
+fn read_tables(path: &Path) -> Result<Vec<(String, toml::Table)>, HarnessError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
+    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| HarnessError::Config {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    let mut tables = Vec::new();
+    for (name, value) in table {
+        let toml::Value::Table(params) = value else {
+            return Err(HarnessError::Config {
+                path: path.to_path_buf(),
+                message: format!("`{name}` must be a table of parameters, e.g. [{name}]"),
+            });
+        };
+        tables.push((name, params));
+    }
+    // toml's map is sorted by key; report order follows the file.
+    tables.sort_by_key(|(name, _)| text.find(&format!("[{name}]")).unwrap_or(usize::MAX));
+    Ok(tables)
+}
+
+/// The external method `name` of `path` (its table `table`).
+fn external(
+    path: &Path,
+    name: &str,
+    table: &toml::Table,
+    origin: Origin,
+) -> Result<ConfiguredMethod, HarnessError> {
+    let config = |message: String| HarnessError::Config {
+        path: path.to_path_buf(),
+        message: format!("[{name}]: {message}"),
+    };
+    if !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+        return Err(config("a method name is letters, digits, `_` and `-` (it names report files)".into()));
+    }
+    if let Some(key) = table.keys().find(|k| !EXTERNAL_KEYS.contains(&k.as_str())) {
+        return Err(config(format!(
+            "unknown key `{key}` (an external method takes {}; its own parameters go in [{name}.params])",
+            EXTERNAL_KEYS.join(", ")
+        )));
+    }
+    let command: Vec<String> = match table.get("command") {
+        Some(toml::Value::Array(items)) if !items.is_empty() => items
+            .iter()
+            .map(|v| v.as_str().map(str::to_string))
+            .collect::<Option<_>>()
+            .ok_or_else(|| config("`command` must be a list of strings".into()))?,
+        _ => {
+            return Err(config(
+                "`command` must be a non-empty list of strings: [\"program\", \"arg\", …]".into(),
+            ))
+        }
+    };
+    let command = command
+        .iter()
+        .map(|part| crate::variables::expand(part, "the command of an external method"))
+        .collect::<Result<Vec<String>, String>>()
+        .map_err(config)?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let working_dir = match table.get("working_dir") {
+        None => base.clone(),
+        Some(toml::Value::String(dir)) => {
+            let dir = PathBuf::from(crate::variables::expand(dir, "working_dir").map_err(config)?);
+            if dir.is_absolute() {
+                dir
+            } else {
+                base.join(dir)
+            }
+        }
+        Some(_) => return Err(config("`working_dir` must be a string".into())),
+    };
+    if !working_dir.is_dir() {
+        return Err(config(format!("working_dir {} is not a directory", working_dir.display())));
+    }
+    let working_dir = working_dir.canonicalize().unwrap_or(working_dir);
+    let timeout = match table.get("timeout_s") {
+        None => methods::external::DEFAULT_TIMEOUT,
+        Some(v) => match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
+            Some(s) if s.is_finite() && s > 0.0 => Duration::from_secs_f64(s),
+            _ => return Err(config("`timeout_s` must be a positive number of seconds".into())),
+        },
+    };
+    let summary = match table.get("summary") {
+        None => format!("external program `{}`", command.join(" ")),
+        Some(toml::Value::String(s)) => s.clone(),
+        Some(_) => return Err(config("`summary` must be a string".into())),
+    };
+    let params = match table.get("params") {
+        None => toml::Table::new(),
+        Some(toml::Value::Table(t)) => t.clone(),
+        Some(_) => return Err(config("`params` must be a table".into())),
+    };
+    let json = serde_json::to_value(&params).map_err(|e| config(format!("params: {e}")))?;
+    let mut command = command.into_iter();
+    Ok(ConfiguredMethod {
+        name: name.to_string(),
+        origin,
+        params,
+        external: Some(ExternalEntry {
+            program: command.next().expect("non-empty"),
+            args: command.collect(),
+            working_dir,
+            timeout,
+            summary,
+            params: json,
+        }),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn load(text: &str) -> Result<MethodCatalog, String> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("methods.toml");
+        std::fs::write(&path, text).unwrap();
+        MethodCatalog::load(&path).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn an_external_entry_is_read_in_file_order_after_the_built_in_ones() {
+        std::env::set_var("DEFORMBENCH_CONFIG_TEST_PROGRAM", "/usr/bin/env");
+        let catalog = load(
+            "[zeta]\ncommand = [\"${DEFORMBENCH_CONFIG_TEST_PROGRAM}\", \"x.py\"]\ntimeout_s = 5\n\
+             [zeta.params]\nk = 2\nname = \"a\"\n\n[alpha]\ncommand = [\"prog\"]\n\n[arap]\nmax_iterations = 5\n",
+        )
+        .unwrap();
+        let names: Vec<&str> = catalog.names().collect();
+        let builtin = methods::registry::METHODS.len();
+        assert_eq!(&names[builtin..], &["zeta", "alpha"]);
+        let zeta = catalog.get("zeta").unwrap();
+        let e = zeta.external.as_ref().unwrap();
+        assert_eq!((e.program.as_str(), e.args.as_slice()), ("/usr/bin/env", &["x.py".to_string()][..]));
+        assert_eq!(e.timeout, Duration::from_secs(5));
+        assert_eq!(e.params, serde_json::json!({"k": 2, "name": "a"}));
+        assert_eq!(zeta.origin, Origin::External);
+        assert_eq!(catalog.get("arap").unwrap().params.get("max_iterations").unwrap().as_integer(), Some(5));
+    }
+
+    #[test]
+    fn bad_external_entries_are_named() {
+        let err = load("[m]\ncommand = []\n").unwrap_err();
+        assert!(err.contains("[m]") && err.contains("non-empty list"), "{err}");
+        let err = load("[m]\ncommand = [\"p\"]\nk = 2\n").unwrap_err();
+        assert!(err.contains("unknown key `k`") && err.contains("[m.params]"), "{err}");
+        let err = load("[m]\ncommand = [\"${DEFORMBENCH_SURELY_UNSET}\"]\n").unwrap_err();
+        assert!(err.contains("DEFORMBENCH_SURELY_UNSET"), "{err}");
+        let err = load("[arap]\ncommand = [\"p\"]\n").unwrap_err();
+        assert!(err.contains("built-in"), "{err}");
+        let err = load("[m]\ncommand = [\"p\"]\ntimeout_s = 0\n").unwrap_err();
+        assert!(err.contains("timeout_s"), "{err}");
+        let err = load("[\"a b\"]\ncommand = [\"p\"]\n").unwrap_err();
+        assert!(err.contains("letters, digits"), "{err}");
+        let err = load("[nosuch]\nk = 1\n").unwrap_err();
+        assert!(err.contains("unknown method `nosuch`"), "{err}");
     }
 }

@@ -13,6 +13,7 @@ pub mod report;
 pub mod scenario;
 pub mod shard;
 pub mod suite;
+pub mod variables;
 pub mod verdict;
 
 pub use error::HarnessError;

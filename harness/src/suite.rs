@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::case::{run_case, CaseResult, Reference};
-use crate::config::MethodParams;
+use crate::config::MethodCatalog;
 use crate::error::HarnessError;
 use crate::metrics::RestGeometry;
 use crate::scenario::{load_spec, load_specs, DataSource, LoadedScenario, ScenarioSpec, FILE_SOURCE};
@@ -31,6 +31,9 @@ pub struct SuiteOptions {
     pub scenarios: Vec<String>,
     /// Restrict to these methods (empty: each scenario's list).
     pub methods: Vec<String>,
+    /// Add the peer methods of this file (`configs/peers.toml`, `--peers`) to every scenario that
+    /// does not restrict its methods.
+    pub peers: Option<PathBuf>,
     pub progress: bool,
 }
 
@@ -44,6 +47,21 @@ pub struct SuiteRun {
 }
 
 impl SuiteOptions {
+    /// Take the peers' file when `peers` has one (`--peers` with its Python found); returns the note
+    /// that says why peers were asked for but not run.
+    pub fn add_peers(&mut self, peers: Option<Result<PathBuf, String>>) -> Option<String> {
+        match peers? {
+            Ok(file) => {
+                self.peers = Some(file);
+                None
+            }
+            Err(reason) => {
+                eprintln!("note: {reason}");
+                Some(reason)
+            }
+        }
+    }
+
     /// The data source: `survey_dir` if given (it must exist), else procedural look-alikes.
     pub fn data_source(&self) -> Result<DataSource, HarnessError> {
         match &self.survey_dir {
@@ -57,26 +75,43 @@ impl SuiteOptions {
     }
 }
 
-/// The configuration of a run: method parameters and verdict rules.
+/// The configuration of a run: its methods with their parameters, and the verdict rules.
 pub struct RunConfig {
-    pub params: MethodParams,
+    pub catalog: MethodCatalog,
     pub rules: VerdictRules,
 }
 
-/// Load and validate the configuration (`methods.toml`, `verdicts.toml`) and every selected scenario.
+/// Load and validate the configuration (`methods.toml`, the peers when asked for, `verdicts.toml`)
+/// and every selected scenario.
 pub fn prepare(options: &SuiteOptions) -> Result<(RunConfig, Vec<LoadedScenario>, DataSource), HarnessError> {
-    let params = MethodParams::load(&options.configs_dir.join("methods.toml"))?;
+    let catalog = load_catalog(options)?;
     let rules = VerdictRules::load(&options.configs_dir.join("verdicts.toml"))?;
     for m in &options.methods {
-        methods::registry::find(m)?;
+        catalog
+            .find(m)
+            .map_err(|message| HarnessError::Config { path: catalog.path().to_path_buf(), message })?;
     }
     let specs = select_specs(options)?;
+    for spec in &specs {
+        for m in spec.methods.iter().flatten() {
+            catalog.find(m).map_err(|message| HarnessError::Config { path: spec.path.clone(), message })?;
+        }
+    }
     let source = options.data_source()?;
     let mut scenarios = Vec::with_capacity(specs.len());
     for spec in &specs {
         scenarios.extend(spec.load(&source)?);
     }
-    Ok((RunConfig { params, rules }, scenarios, source))
+    Ok((RunConfig { catalog, rules }, scenarios, source))
+}
+
+/// The methods of a run: `methods.toml` of the configuration directory, and the peers if asked for.
+pub fn load_catalog(options: &SuiteOptions) -> Result<MethodCatalog, HarnessError> {
+    let mut catalog = MethodCatalog::load(&options.configs_dir.join("methods.toml"))?;
+    if let Some(peers) = &options.peers {
+        catalog.add_peers(peers)?;
+    }
+    Ok(catalog)
 }
 
 /// The scenario files of the run: every one in the scenarios directory, or the ones named (by name, or
@@ -112,15 +147,18 @@ fn select_specs(options: &SuiteOptions) -> Result<Vec<ScenarioSpec>, HarnessErro
     Ok(specs)
 }
 
-/// The methods of each scenario the run covers (`options.methods` applied), in registry order.
-fn plan(options: &SuiteOptions, scenarios: &[LoadedScenario]) -> Vec<Vec<&'static str>> {
+/// The methods of each scenario the run covers, in catalog order: those its `methods` list names,
+/// else every method of the catalog (peers included when the run added them); `options.methods`
+/// applied.
+fn plan(options: &SuiteOptions, catalog: &MethodCatalog, scenarios: &[LoadedScenario]) -> Vec<Vec<String>> {
     scenarios
         .iter()
         .map(|s| {
-            s.spec
-                .method_names()
-                .into_iter()
+            catalog
+                .names()
+                .filter(|m| s.spec.methods.as_ref().is_none_or(|list| list.iter().any(|l| l == m)))
                 .filter(|m| options.methods.is_empty() || options.methods.iter().any(|x| x == m))
+                .map(str::to_string)
                 .collect()
         })
         .collect()
@@ -130,7 +168,7 @@ fn plan(options: &SuiteOptions, scenarios: &[LoadedScenario]) -> Vec<Vec<&'stati
 /// the others can be compared with it; results are reported in registry order.
 pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
     let (config, scenarios, source) = prepare(options)?;
-    let plan = plan(options, &scenarios);
+    let plan = plan(options, &config.catalog, &scenarios);
     let results = run_plan(options, &config, &scenarios, &plan);
     let data_source = describe_data(&source, &scenarios);
     Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source })
@@ -140,10 +178,14 @@ pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
 pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, HarnessError> {
     let (config, scenarios, source) = prepare(options)?;
     let data_source = describe_data(&source, &scenarios);
-    let plan = plan(options, &scenarios);
-    let costs: Vec<f64> = scenarios.iter().zip(&plan).map(|(s, m)| estimated_cost(s, m)).collect();
+    let plan = plan(options, &config.catalog, &scenarios);
+    let costs: Vec<f64> = scenarios
+        .iter()
+        .zip(&plan)
+        .map(|(s, m)| estimated_cost(s, &m.iter().map(String::as_str).collect::<Vec<_>>()))
+        .collect();
     let shard_of = assign(&costs, shard.count);
-    let (mine, plan): (Vec<(LoadedScenario, bool)>, Vec<Vec<&'static str>>) = scenarios
+    let (mine, plan): (Vec<(LoadedScenario, bool)>, Vec<Vec<String>>) = scenarios
         .into_iter()
         .zip(plan)
         .zip(&shard_of)
@@ -168,7 +210,7 @@ fn run_plan(
     options: &SuiteOptions,
     config: &RunConfig,
     scenarios: &[LoadedScenario],
-    plan: &[Vec<&'static str>],
+    plan: &[Vec<String>],
 ) -> Vec<CaseResult> {
     let total: usize = plan.iter().map(Vec::len).sum();
     let bar = if options.progress { ProgressBar::new(total as u64) } else { ProgressBar::hidden() };
@@ -180,12 +222,13 @@ fn run_plan(
     let mut results = Vec::with_capacity(total);
     for (scenario, names) in scenarios.iter().zip(plan) {
         let rest = RestGeometry::new(&scenario.mesh, &scenario.topology);
-        let mut order = names.clone();
+        let mut order: Vec<&str> = names.iter().map(String::as_str).collect();
         order.sort_by_key(|m| *m != REFERENCE_METHOD);
         let mut cases: Vec<CaseResult> = Vec::with_capacity(order.len());
         for method in order {
-            bar.set_message(format!("{} / {method}", scenario.spec.name));
-            let reference = if method == REFERENCE_METHOD {
+            let method = config.catalog.get(method).expect("planned from the catalog");
+            bar.set_message(format!("{} / {}", scenario.spec.name, method.name));
+            let reference = if method.name == REFERENCE_METHOD {
                 Reference::Itself
             } else {
                 cases
@@ -194,8 +237,13 @@ fn run_plan(
                     .and_then(|c| c.positions.as_deref())
                     .map_or(Reference::Missing, Reference::Of)
             };
-            let case =
-                run_case(scenario, &rest, method, &config.params.get(method), &config.rules, reference);
+            let stderr_log = method.external.as_ref().map(|_| {
+                options
+                    .reports_dir
+                    .join("logs")
+                    .join(format!("{}-{}.stderr.txt", scenario.spec.name, method.name))
+            });
+            let case = run_case(scenario, &rest, method, stderr_log, &config.rules, reference);
             cases.push(case);
             bar.inc(1);
         }
@@ -211,7 +259,7 @@ fn run_plan(
 /// from its mesh file. Errors: a missing or repeated part, parts of different runs (data source or
 /// N), a case of a scenario the options do not load, a mesh that does not fit its scenario.
 pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, HarnessError> {
-    let (_, scenarios, source) = prepare(options)?;
+    let (config, scenarios, source) = prepare(options)?;
     let data_source = describe_data(&source, &scenarios);
     let mut parts: Vec<(Shard, PathBuf, Vec<CaseResult>)> = Vec::with_capacity(dirs.len());
     for dir in dirs {
@@ -242,7 +290,7 @@ pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, Harne
             message: format!("the merge lacks part(s) {}", missing.join(", ")),
         });
     }
-    let plan = plan(options, &scenarios);
+    let plan = plan(options, &config.catalog, &scenarios);
     let mut results: Vec<(usize, usize, CaseResult)> = Vec::new();
     for (_, dir, cases) in parts {
         for mut case in cases {

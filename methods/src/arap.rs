@@ -243,7 +243,7 @@ impl Arap {
 }
 
 impl DeformationMethod for Arap {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> &str {
         "arap"
     }
 

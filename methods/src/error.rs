@@ -28,6 +28,10 @@ pub enum MethodError {
     Eigen(crate::linalg::spectral::EigenError),
     #[error("`{method}` produced a non-finite position at vertex {vertex} in iteration {iteration}")]
     NonFinite { method: &'static str, vertex: usize, iteration: usize },
+    #[error("`{method}`'s result has a non-finite position at vertex {vertex}")]
+    NonFiniteResult { method: String, vertex: usize },
+    #[error("external method `{method}`: {message}")]
+    External { method: String, message: String },
     #[error("`{method}` diverged: iteration {iteration} moved a vertex {step:.3e} bounding-box diagonals")]
     Diverged { method: &'static str, iteration: usize, step: f64 },
 }

@@ -139,7 +139,7 @@ impl LaplacianEditing {
 }
 
 impl DeformationMethod for LaplacianEditing {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> &str {
         "laplacian"
     }
 

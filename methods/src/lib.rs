@@ -3,6 +3,7 @@
 
 pub mod arap;
 pub mod error;
+pub mod external;
 pub mod handles;
 pub mod hirm;
 pub mod isoline_model;

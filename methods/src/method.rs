@@ -22,11 +22,12 @@ pub struct IterationReport {
 /// Receives per-iteration reports; may ask for the current shape or stop the solve.
 pub trait IterationObserver {
     /// Called after every iteration. `shape` computes the current `#V x 3` positions on demand
-    /// (reduced models reconstruct them, so call it only when needed).
+    /// (reduced models reconstruct them, so call it only when needed); `None` where the iterate is
+    /// out of reach (an external method reports its iterations after its solve).
     fn on_iteration(
         &mut self,
         report: &IterationReport,
-        shape: &dyn Fn() -> Vec<[f64; 3]>,
+        shape: Option<&dyn Fn() -> Vec<[f64; 3]>>,
     ) -> ControlFlow<()>;
 }
 
@@ -34,7 +35,11 @@ pub trait IterationObserver {
 pub struct NoObserver;
 
 impl IterationObserver for NoObserver {
-    fn on_iteration(&mut self, _: &IterationReport, _: &dyn Fn() -> Vec<[f64; 3]>) -> ControlFlow<()> {
+    fn on_iteration(
+        &mut self,
+        _: &IterationReport,
+        _: Option<&dyn Fn() -> Vec<[f64; 3]>>,
+    ) -> ControlFlow<()> {
         ControlFlow::Continue(())
     }
 }
@@ -57,8 +62,8 @@ pub struct SolveSummary {
 ///    current deformed shape (incremental editing);
 /// 3. [`solve`](Self::solve): iterate towards handle targets from the current shape.
 pub trait DeformationMethod: Send {
-    /// Registry name.
-    fn name(&self) -> &'static str;
+    /// Name in configs and reports.
+    fn name(&self) -> &str;
 
     /// Handle-independent precomputation on the rest mesh; resets the current shape to the rest shape.
     fn precompute(&mut self, rest: &TriMesh) -> Result<(), MethodError>;
@@ -77,15 +82,32 @@ pub trait DeformationMethod: Send {
     fn positions(&self) -> Vec<[f64; 3]>;
 
     /// Method-specific phase timings in seconds (e.g. HIRM's t_e, t_b), reported next to the common ones.
-    fn phase_timings(&self) -> Vec<(&'static str, f64)> {
+    fn phase_timings(&self) -> Vec<(String, f64)> {
         Vec::new()
     }
 
     /// Sizes describing a reduced model (e.g. HIRM's `n_field` and `n_t`, Au et al.'s `n_tri`),
     /// reported next to the timings. Counts, not seconds.
-    fn model_statistics(&self) -> Vec<(&'static str, f64)> {
+    fn model_statistics(&self) -> Vec<(String, f64)> {
         Vec::new()
     }
+
+    /// Wall seconds spent starting the method before [`precompute`](Self::precompute) (an external
+    /// program's start-up and handshake), kept out of the precompute time; `None` for a method that
+    /// runs in this process.
+    fn startup_seconds(&self) -> Option<f64> {
+        None
+    }
+
+    /// What runs, in the method's words (an external program's library and version), if it says.
+    fn about(&self) -> Option<String> {
+        None
+    }
+}
+
+/// Phase timings or statistics under their `&'static` keys ([`crate::keys`]) as the trait reports them.
+pub(crate) fn owned_names(list: Vec<(&'static str, f64)>) -> Vec<(String, f64)> {
+    list.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
 }
 
 /// Largest displacement between two `#V x 3` position arrays.
@@ -130,7 +152,7 @@ pub(crate) fn run_iterations<S: ?Sized>(
             final_step: step,
         };
         let state: &S = state;
-        let flow = observer.on_iteration(&report, &|| shape(state));
+        let flow = observer.on_iteration(&report, Some(&|| shape(state)));
         if summary.converged || flow.is_break() {
             break;
         }

@@ -144,7 +144,8 @@ fn paper_phases_are_reported() {
         &handles,
         &targets(&mesh, &handles, &handle, &AffineTransform::translation([0.0, 4.0, 0.0])),
     );
-    let names: Vec<&str> = method.phase_timings().iter().map(|(n, _)| *n).collect();
+    let timings = method.phase_timings();
+    let names: Vec<&str> = timings.iter().map(|(n, _)| n.as_str()).collect();
     for phase in [
         "pt1_manifold_harmonics",
         "pt2_reduced_energy",

@@ -332,9 +332,8 @@ pub fn load_spec(path: &Path) -> Result<ScenarioSpec, HarnessError> {
     if let Some(p) = &spec.procedural {
         p.shape.parse::<ShapeKind>().map_err(|e| config(format!("procedural.shape: {e}")))?;
     }
-    for m in spec.methods.iter().flatten() {
-        methods::registry::find(m).map_err(|e| config(e.to_string()))?;
-    }
+    // The names in `methods` are checked against the run's methods (configs/methods.toml and any
+    // peers) when the run is prepared.
     Ok(spec)
 }
 
@@ -369,15 +368,6 @@ impl ScenarioSpec {
     /// Whether reports write the result meshes of this scenario by default (`result_meshes`).
     pub fn writes_result_meshes(&self) -> bool {
         self.result_meshes.unwrap_or(true)
-    }
-
-    /// Methods to run on this scenario, in registry order.
-    pub fn method_names(&self) -> Vec<&'static str> {
-        let all = methods::registry::method_names();
-        match &self.methods {
-            Some(list) => all.into_iter().filter(|m| list.iter().any(|l| l == m)).collect(),
-            None => all,
-        }
     }
 
     /// Where this scenario's relative paths start.

@@ -93,16 +93,7 @@ impl PathContext {
         } else if text.contains("{stem}") {
             return Err(format!("`{path}`: {{stem}} needs a mesh file (`mesh` or `meshes`)"));
         }
-        while let Some(start) = text.find("${") {
-            let Some(len) = text[start..].find('}') else {
-                return Err(format!("`{path}`: unclosed ${{ in the path"));
-            };
-            let name = &text[start + 2..start + len];
-            let value = std::env::var(name).map_err(|_| {
-                format!("`{path}` needs the environment variable {name} (the directory it names)")
-            })?;
-            text.replace_range(start..start + len + 1, &value);
-        }
+        let text = crate::variables::expand(&text, "the directory it names")?;
         let p = PathBuf::from(text);
         Ok(if p.is_absolute() { p } else { self.base.join(p) })
     }

@@ -330,7 +330,7 @@ impl Hirm {
 }
 
 impl DeformationMethod for Hirm {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> &str {
         "hirm"
     }
 
@@ -495,11 +495,11 @@ impl DeformationMethod for Hirm {
         self.current.clone()
     }
 
-    fn phase_timings(&self) -> Vec<(&'static str, f64)> {
-        self.timings.clone()
+    fn phase_timings(&self) -> Vec<(String, f64)> {
+        crate::method::owned_names(self.timings.clone())
     }
 
-    fn model_statistics(&self) -> Vec<(&'static str, f64)> {
+    fn model_statistics(&self) -> Vec<(String, f64)> {
         let mut out = Vec::new();
         if let Some(rest) = &self.rest {
             out.push((crate::keys::statistic::N_FIELD, rest.scores.len() as f64));
@@ -509,6 +509,6 @@ impl DeformationMethod for Hirm {
         if let Some(bound) = &self.bound {
             out.push((crate::keys::statistic::N_T, bound.independent.model.n_sampled_triangles() as f64));
         }
-        out
+        crate::method::owned_names(out)
     }
 }

@@ -195,7 +195,7 @@ impl Isolines {
 }
 
 impl DeformationMethod for Isolines {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> &str {
         self.name
     }
 
@@ -339,16 +339,16 @@ impl DeformationMethod for Isolines {
         self.current.clone()
     }
 
-    fn phase_timings(&self) -> Vec<(&'static str, f64)> {
-        self.timings.clone()
+    fn phase_timings(&self) -> Vec<(String, f64)> {
+        crate::method::owned_names(self.timings.clone())
     }
 
-    fn model_statistics(&self) -> Vec<(&'static str, f64)> {
+    fn model_statistics(&self) -> Vec<(String, f64)> {
         self.bound.as_ref().map_or_else(Vec::new, |b| {
-            vec![
+            crate::method::owned_names(vec![
                 (crate::keys::statistic::N_ISOLINES, b.model.n_isolines() as f64),
                 (crate::keys::statistic::N_TRI, b.model.n_sampled_triangles() as f64),
-            ]
+            ])
         })
     }
 }

@@ -315,7 +315,7 @@ fn max_displacement_to(current: &[[f64; 3]], next: faer::MatRef<'_, f64>) -> f64
 }
 
 impl DeformationMethod for ScaleAware {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> &str {
         self.name
     }
 
@@ -402,7 +402,7 @@ impl DeformationMethod for ScaleAware {
         let report = IterationReport { iteration: 0, step, seconds: self.timings.initialization };
         let current: &[[f64; 3]] = &self.current;
         let summary = SolveSummary { iterations: 1, converged: false, final_step: step };
-        if observer.on_iteration(&report, &|| current.to_vec()) == ControlFlow::Break(()) {
+        if observer.on_iteration(&report, Some(&|| current.to_vec())) == ControlFlow::Break(()) {
             return Ok(summary);
         }
 
@@ -446,7 +446,7 @@ impl DeformationMethod for ScaleAware {
         self.current.clone()
     }
 
-    fn phase_timings(&self) -> Vec<(&'static str, f64)> {
+    fn phase_timings(&self) -> Vec<(String, f64)> {
         let t = &self.timings;
         let mut phases = vec![
             (crate::keys::phase::INITIALIZATION_LAPLACIAN, t.initialization),
@@ -458,13 +458,13 @@ impl DeformationMethod for ScaleAware {
         if self.params.optimal_rigidity {
             phases.push((crate::keys::phase::ORA_STITCHING, t.stitching));
         }
-        phases
+        crate::method::owned_names(phases)
     }
 
-    fn model_statistics(&self) -> Vec<(&'static str, f64)> {
-        vec![
+    fn model_statistics(&self) -> Vec<(String, f64)> {
+        crate::method::owned_names(vec![
             (crate::keys::statistic::OUTER_ITERATIONS, self.timings.outer_iterations as f64),
             (crate::keys::statistic::NORMAL_ITERATIONS, self.timings.normal_iterations as f64),
-        ]
+        ])
     }
 }

@@ -209,7 +209,7 @@ fn to_rows(m: &Mat<f64>) -> Vec<[f64; 3]> {
 }
 
 impl DeformationMethod for SpectralMhb {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> &str {
         "spectral_mhb"
     }
 
@@ -428,7 +428,7 @@ impl DeformationMethod for SpectralMhb {
         self.set_timing(crate::keys::phase::RT2_DETAILS, details);
         let report = IterationReport { iteration: 0, step, seconds: start.elapsed().as_secs_f64() };
         let current = &self.current;
-        let _ = observer.on_iteration(&report, &|| current.clone());
+        let _ = observer.on_iteration(&report, Some(&|| current.clone()));
         Ok(SolveSummary { iterations: 1, converged: true, final_step: step })
     }
 
@@ -436,7 +436,7 @@ impl DeformationMethod for SpectralMhb {
         self.current.clone()
     }
 
-    fn phase_timings(&self) -> Vec<(&'static str, f64)> {
-        self.timings.clone()
+    fn phase_timings(&self) -> Vec<(String, f64)> {
+        crate::method::owned_names(self.timings.clone())
     }
 }
