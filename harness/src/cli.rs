@@ -6,11 +6,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use crate::case::CaseResult;
+use crate::config::PeerSetup;
 use crate::metrics::METRICS;
 use crate::peers;
 use crate::pipeline::{self, GateRequest, Outcome, PublishOptions};
 use crate::regression::{self, GateOutcome};
-use crate::report::{MeshFormat, MeshOutput};
+use crate::report::{peer_comparison, MeshFormat, MeshOutput};
 use crate::scenario::load_specs;
 use crate::shard::Shard;
 use crate::suite::{self, SuiteOptions, SURVEY_DIR_ENV};
@@ -113,17 +114,14 @@ struct Peers {
 }
 
 impl Peers {
-    /// The peer methods' file when `--peers` was given and the Python is there (it is exported as
-    /// DEFORMBENCH_PYTHON for their commands); `Err` says why peers are not run.
-    fn peer_methods(&self, configs_dir: &std::path::Path) -> Option<Result<PathBuf, String>> {
+    /// The peer methods' file and Python when `--peers` was given and the Python is there; `Err`
+    /// says why peers are not run.
+    fn peer_methods(&self, configs_dir: &std::path::Path) -> Option<Result<PeerSetup, String>> {
         if !self.peers {
             return None;
         }
         Some(match &self.python {
-            Some(p) if p.is_file() => {
-                std::env::set_var(peers::PYTHON_ENV, p);
-                Ok(configs_dir.join("peers.toml"))
-            }
+            Some(p) if p.is_file() => Ok(PeerSetup { file: configs_dir.join("peers.toml"), python: p.clone() }),
             Some(p) => Err(format!("peers not run: the Python {} does not exist", p.display())),
             None => Err(format!(
                 "peers not run: they need the cross-check Python with libigl and open3d; give --python or set {} \
@@ -332,7 +330,7 @@ fn run_shard(options: &SuiteOptions, shard: Shard) -> anyhow::Result<ExitCode> {
         options.reports_dir.display()
     );
     if failed > 0 {
-        eprintln!("error: some case(s) failed (see the status column)");
+        eprintln!("error: {failed} case(s) failed: {} (see the status column)", failed_cases(&run.results));
         return Ok(ExitCode::from(EXIT_CASE_FAILED));
     }
     Ok(ExitCode::SUCCESS)
@@ -352,6 +350,10 @@ fn publish_and_print(
     let outcome = pipeline::publish(options, &mut run, publish, gate).context("publishing the run")?;
     println!("data: {}", run.data_source);
     print_table(&run.results);
+    let peers = peer_comparison::render_markdown(&peer_comparison::arap_against_libigl(&run.results));
+    if !peers.is_empty() {
+        println!("\n{peers}");
+    }
     print_phases(&outcome);
     println!("reports: {} (open index.html)", options.reports_dir.display());
     let gate_code = match &outcome.gate {
@@ -371,10 +373,24 @@ fn publish_and_print(
         );
     }
     if outcome.failed > 0 {
-        eprintln!("error: {} case(s) failed (see the status column)", outcome.failed);
+        eprintln!(
+            "error: {} case(s) failed: {} (see the status column)",
+            outcome.failed,
+            failed_cases(&run.results)
+        );
         return Ok(ExitCode::from(EXIT_CASE_FAILED));
     }
     Ok(gate_code)
+}
+
+/// `scenario / method` of every failed case, comma-separated.
+fn failed_cases(results: &[CaseResult]) -> String {
+    let names: Vec<String> = results
+        .iter()
+        .filter(|r| r.status.is_failed())
+        .map(|r| format!("{} / {}", r.scenario, r.method))
+        .collect();
+    names.join(", ")
 }
 
 /// Where the run's wall time went, one line per phase.

@@ -53,6 +53,15 @@ pub struct ExternalEntry {
     pub params: serde_json::Value,
 }
 
+/// The peers of a run (`--peers`): their file and the Python they run in.
+#[derive(Clone, Debug)]
+pub struct PeerSetup {
+    /// `configs/peers.toml`.
+    pub file: PathBuf,
+    /// The cross-check Python, `${DEFORMBENCH_PYTHON}` in their commands.
+    pub python: PathBuf,
+}
+
 /// One method of a run.
 #[derive(Clone, Debug)]
 pub struct ConfiguredMethod {
@@ -121,7 +130,7 @@ impl MethodCatalog {
                         "`{name}` is a built-in method; an external one needs another name"
                     )));
                 }
-                methods.push(external(path, &name, &table, Origin::External)?);
+                methods.push(external(path, &name, &table, Origin::External, &[])?);
             } else {
                 // Building the method validates the name and every key.
                 methods::registry::create(&name, &table).map_err(|e| config(e.to_string()))?;
@@ -132,8 +141,12 @@ impl MethodCatalog {
         Ok(Self { path: path.to_path_buf(), methods })
     }
 
-    /// Add the external methods of `path` (`configs/peers.toml`) as peers.
-    pub fn add_peers(&mut self, path: &Path) -> Result<(), HarnessError> {
+    /// Add the external methods of `peers.file` (`configs/peers.toml`) as peers, with
+    /// `${DEFORMBENCH_PYTHON}` the peers' Python.
+    pub fn add_peers(&mut self, peers: &PeerSetup) -> Result<(), HarnessError> {
+        let path = &peers.file;
+        let python = peers.python.to_string_lossy();
+        let given = [(crate::peers::PYTHON_ENV, python.as_ref())];
         for (name, table) in read_tables(path)? {
             if self.methods.iter().any(|m| m.name == name) {
                 return Err(HarnessError::Config {
@@ -141,7 +154,7 @@ impl MethodCatalog {
                     message: format!("peer `{name}` has the name of a method of {}", self.path.display()),
                 });
             }
-            self.methods.push(external(path, &name, &table, Origin::Peer)?);
+            self.methods.push(external(path, &name, &table, Origin::Peer, &given)?);
         }
         Ok(())
     }
@@ -196,12 +209,14 @@ fn read_tables(path: &Path) -> Result<Vec<(String, toml::Table)>, HarnessError> 
     Ok(tables)
 }
 
-/// The external method `name` of `path` (its table `table`).
+/// The external method `name` of `path` (its table `table`), `given` variables before the
+/// environment's.
 fn external(
     path: &Path,
     name: &str,
     table: &toml::Table,
     origin: Origin,
+    given: &[(&str, &str)],
 ) -> Result<ConfiguredMethod, HarnessError> {
     let config = |message: String| HarnessError::Config {
         path: path.to_path_buf(),
@@ -230,7 +245,7 @@ fn external(
     };
     let command = command
         .iter()
-        .map(|part| crate::variables::expand(part, "the command of an external method"))
+        .map(|part| crate::variables::expand_with(part, "the command of an external method", given))
         .collect::<Result<Vec<String>, String>>()
         .map_err(config)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();

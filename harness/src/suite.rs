@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::case::{run_case, CaseResult, Reference};
-use crate::config::MethodCatalog;
+use crate::config::{MethodCatalog, PeerSetup};
 use crate::error::HarnessError;
 use crate::metrics::RestGeometry;
 use crate::scenario::{load_spec, load_specs, DataSource, LoadedScenario, ScenarioSpec, FILE_SOURCE};
@@ -15,6 +15,10 @@ use crate::verdict::VerdictRules;
 
 /// The method every other is compared with (`rms_to_arap_over_diag`, `max_to_arap_over_diag`).
 pub const REFERENCE_METHOD: &str = methods::registry::ARAP;
+
+/// The peer that runs the reference's energy to the same tolerance (configs/peers.toml): the page
+/// sets their times to convergence side by side.
+pub const PEER_OF_REFERENCE: &str = "libigl_arap";
 
 /// Environment variable naming the survey data directory (same as `--survey-dir`).
 pub const SURVEY_DIR_ENV: &str = "DEFORM_SURVEY_DIR";
@@ -33,7 +37,7 @@ pub struct SuiteOptions {
     pub methods: Vec<String>,
     /// Add the peer methods of this file (`configs/peers.toml`, `--peers`) to every scenario that
     /// does not restrict its methods.
-    pub peers: Option<PathBuf>,
+    pub peers: Option<PeerSetup>,
     pub progress: bool,
 }
 
@@ -49,10 +53,10 @@ pub struct SuiteRun {
 impl SuiteOptions {
     /// Take the peers' file when `peers` has one (`--peers` with its Python found); returns the note
     /// that says why peers were asked for but not run.
-    pub fn add_peers(&mut self, peers: Option<Result<PathBuf, String>>) -> Option<String> {
+    pub fn add_peers(&mut self, peers: Option<Result<PeerSetup, String>>) -> Option<String> {
         match peers? {
-            Ok(file) => {
-                self.peers = Some(file);
+            Ok(setup) => {
+                self.peers = Some(setup);
                 None
             }
             Err(reason) => {

@@ -7,9 +7,11 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::case::CaseResult;
+use crate::config::Origin;
 use crate::error::HarnessError;
 use crate::metrics::METRICS;
 use crate::regression::GateOutcome;
+use crate::report::peer_comparison;
 
 /// Escape text for HTML element content and attribute values.
 fn escape(text: &str) -> String {
@@ -43,6 +45,7 @@ pub fn render_index(
         "table{border-collapse:collapse;font-size:13px;margin:1em 0}\n",
         "th,td{border:1px solid #ccc;padding:3px 7px;text-align:right}\n",
         "th{background:#f0f0f0}td.text{text-align:left}\n",
+        "span.origin{font-size:11px;color:#fff;background:#557;border-radius:3px;padding:0 4px;margin-left:4px}\n",
         "tr.failed td{background:#fdd}tr.suspect td{background:#fff1d6}tr.unfinished td{background:#e4e8ff}\n",
         "td.status{min-width:260px;max-width:360px;font-size:12px}td{white-space:nowrap}\n",
         "td.status{white-space:normal}div.scroll{overflow-x:auto}dl.metrics dt{font-weight:bold;margin-top:.3em}\n",
@@ -75,7 +78,9 @@ pub fn render_index(
          handles, leaves its frame or turns a free region far beyond its handles, with the reasons (thresholds in \
          <code>configs/verdicts.toml</code>); <code>unfinished</code> (blue) when its iteration stopped at the \
          cap before its tolerance, so the measures are of an iterate, not of the method's answer; \
-         <code>failed</code> (red) when the method gave no result.</p>\n",
+         <code>failed</code> (red) when the method gave no result. Rows marked <span class=\"origin\">peer</span> are \
+         peer libraries' methods (<code>--peers</code>, <code>configs/peers.toml</code>), <span class=\"origin\">external</span> \
+         other programs over the method protocol (README); hover the mark for what ran.</p>\n",
     );
 
     if !notes.is_empty() {
@@ -114,7 +119,7 @@ pub fn render_index(
     page.push_str(
         "<h2 id=\"results\">Results</h2>\n<div class=\"scroll\"><table>\n<tr><th>scenario</th><th>method</th>\
          <th>status</th><th>#V</th>\
-         <th>iterations</th><th>converged</th><th>precompute</th><th>bind</th><th>solve</th><th>total</th>\
+         <th>iterations</th><th>converged</th><th title=\"an external method's process start-up, not part of precompute\">startup</th><th>precompute</th><th>bind</th><th>solve</th><th>total</th>\
          <th>iteration (ms)</th>",
     );
     for spec in &METRICS {
@@ -122,17 +127,28 @@ pub fn render_index(
     }
     page.push_str("<th>self-intersecting (open3d)</th></tr>\n");
     for r in results {
-        let class = format!(" class=\"{}\"", r.status.kind());
+        let (class, badge) = match r.origin {
+            Origin::BuiltIn => (r.status.kind().to_string(), String::new()),
+            other => (
+                format!("{} {}", r.status.kind(), other.label()),
+                format!(
+                    "<span class=\"origin\" title=\"{}\">{}</span>",
+                    escape(r.about.as_deref().unwrap_or("")),
+                    other.label()
+                ),
+            ),
+        };
         let _ = write!(
             page,
-            "<tr{class}><td class=\"text\">{}</td><td class=\"text\">{}</td><td class=\"text status\">{}</td>\
-             <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>",
+            "<tr class=\"{class}\"><td class=\"text\">{}</td><td class=\"text\">{}{badge}</td><td class=\"text status\">{}</td>\
+             <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>",
             escape(&r.scenario),
             escape(&r.method),
             escape(&r.status.to_string()),
             r.vertices,
             r.iterations,
             if r.converged { "yes" } else { "no" },
+            number(r.startup_s, 3),
             number(r.precompute_s, 3),
             number(r.bind_s, 4),
             number(r.solve_s, 3),
@@ -149,6 +165,11 @@ pub fn render_index(
         );
     }
     page.push_str("</table></div>\n");
+    let peers = peer_comparison::render_markdown(&peer_comparison::arap_against_libigl(results));
+    if !peers.is_empty() {
+        page.push_str("<h2 id=\"arap-libigl\">Our arap against libigl's</h2>\n");
+        page.push_str(&markdown_table(&peers));
+    }
 
     let (figures, plots): (Vec<&PathBuf>, Vec<&PathBuf>) = images
         .iter()

@@ -27,9 +27,11 @@ const SIZE: (u32, u32) = (960, 540);
 /// Pixel size of the errors plot (one panel per plotted metric, side by side).
 const ERRORS_SIZE: (u32, u32) = (1500, 560);
 
-/// Method colours, fixed by registry order so a method has the same colour in every plot.
-fn method_color(method: &str) -> RGBColor {
-    const PALETTE: [RGBColor; 10] = [
+/// Method colours, fixed by registry order so a method has the same colour in every plot; the other
+/// methods (external, peers) of `cases` follow in their order there, which is the catalog's in every
+/// scenario they run on.
+fn method_color(method: &str, cases: &[&CaseResult]) -> RGBColor {
+    const PALETTE: [RGBColor; 15] = [
         RGBColor(31, 119, 180),
         RGBColor(255, 127, 14),
         RGBColor(44, 160, 44),
@@ -40,8 +42,22 @@ fn method_color(method: &str) -> RGBColor {
         RGBColor(127, 127, 127),
         RGBColor(188, 189, 34),
         RGBColor(23, 190, 207),
+        RGBColor(0, 0, 0),
+        RGBColor(128, 0, 0),
+        RGBColor(0, 90, 90),
+        RGBColor(90, 60, 0),
+        RGBColor(70, 0, 130),
     ];
-    let index = methods::registry::method_names().iter().position(|m| *m == method).unwrap_or(0);
+    let builtin = methods::registry::method_names();
+    let index = builtin.iter().position(|m| *m == method).unwrap_or_else(|| {
+        let mut others: Vec<&str> = Vec::new();
+        for c in cases {
+            if !builtin.contains(&c.method.as_str()) && !others.contains(&c.method.as_str()) {
+                others.push(&c.method);
+            }
+        }
+        builtin.len() + others.iter().position(|m| *m == method).unwrap_or(0)
+    });
     PALETTE[index % PALETTE.len()]
 }
 
@@ -261,7 +277,7 @@ fn draw_errors<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &[
         for (i, (c, value)) in cases.iter().zip(&values).enumerate() {
             let y = n - 1.0 - i as f64;
             row_y.push(chart.backend_coord(&(0.0, y + 0.5)).1);
-            let color = method_color(&c.method);
+            let color = method_color(&c.method, cases);
             let text = if value.is_finite() {
                 let faded = c.status.is_suspect() || c.status.is_unfinished();
                 let style = if faded { color.mix(0.4).filled() } else { color.filled() };
@@ -408,7 +424,7 @@ where
         .draw()
         .map_err(err)?;
     for c in cases {
-        let style = method_color(&c.method).stroke_width(2);
+        let style = method_color(&c.method, cases).stroke_width(2);
         chart
             .draw_series(LineSeries::new(points(c), style))
             .map_err(err)?
@@ -461,7 +477,7 @@ fn draw_scaling<DB: DrawingBackend>(root: Area<'_, DB>, sweeps: &[&CaseResult]) 
         .draw()
         .map_err(err)?;
     for m in methods {
-        let color = method_color(m);
+        let color = method_color(m, sweeps);
         labelled_line(&mut chart, line(m), color, color.stroke_width(2), m.to_string())?;
     }
     draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, 14)
@@ -564,7 +580,7 @@ fn draw_table1<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult]) ->
         .draw()
         .map_err(err)?;
     for c in cases {
-        let color = method_color(&c.method);
+        let color = method_color(&c.method, cases);
         let dashed = c.scenario.starts_with("cactus");
         let label = format!("{} ({})", c.method, c.scenario);
         let points = series(c);

@@ -17,10 +17,12 @@ use crate::shard::Shard;
 const CASE_COLUMNS: &[&str] = &[
     "scenario",
     "method",
+    "origin",
     "mesh_source",
     "vertices",
     "faces",
     "laplacian_weights",
+    "startup_s",
     "precompute_s",
     "bind_s",
     "median_iteration_ms",
@@ -99,10 +101,12 @@ pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
         let mut row = vec![
             r.scenario.clone(),
             r.method.clone(),
+            r.origin.label().to_string(),
             r.mesh_source.clone(),
             r.vertices.to_string(),
             r.faces.to_string(),
             r.laplacian_weights.clone(),
+            num(r.startup_s),
             num(r.precompute_s),
             num(r.bind_s),
             num(r.median_iteration_ms),
@@ -302,7 +306,8 @@ pub struct MeshOutput {
     pub every_scenario: bool,
 }
 
-/// Write `results.csv`, `results.json`, `convergence.csv`, `handle_updates.csv`, `table1.md` and
+/// Write `results.csv`, `results.json`, `convergence.csv`, `handle_updates.csv`, `table1.md`,
+/// `peers.md` (our `arap` against libigl's, when both ran) and
 /// the result meshes `meshes/<scenario>-<method>.{glb,off}` that `meshes` asks for under `dir`.
 pub fn write_reports(
     dir: &Path,
@@ -317,6 +322,11 @@ pub fn write_reports(
     write_bytes(&dir.join("convergence.csv"), &render_convergence(results)?)?;
     write_bytes(&dir.join("handle_updates.csv"), &render_handle_updates(results)?)?;
     write_bytes(&dir.join("table1.md"), render_table1(results).as_bytes())?;
+    let peers =
+        super::peer_comparison::render_markdown(&super::peer_comparison::arap_against_libigl(results));
+    if !peers.is_empty() {
+        write_bytes(&dir.join("peers.md"), peers.as_bytes())?;
+    }
     write_bytes(&dir.join("results.json"), &json)?;
     write_bytes(&dir.join("results.csv"), &csv)?;
     Ok(())

@@ -1,0 +1,272 @@
+//! External methods through the whole harness: the README's one-file example runs as written; a
+//! broken method beside built-in ones fails alone (built-in rows bitwise equal to a run without it,
+//! exit code 1 naming the failed cases, nothing left running); the peers run beside `arap` and land
+//! near it, and without their Python the run says so.
+
+mod support;
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+fn run(args: &[&str]) -> anyhow::Result<ExitCode> {
+    let mut full = vec!["harness"];
+    full.extend_from_slice(args);
+    harness::cli::run(full)
+}
+
+fn csv_rows(path: &Path) -> Vec<HashMap<String, String>> {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let headers = reader.headers().unwrap().clone();
+    reader
+        .records()
+        .map(|r| headers.iter().map(String::from).zip(r.unwrap().iter().map(String::from)).collect())
+        .collect()
+}
+
+fn row<'a>(rows: &'a [HashMap<String, String>], method: &str) -> &'a HashMap<String, String> {
+    rows.iter().find(|r| r["method"] == method).unwrap_or_else(|| panic!("no row of {method}"))
+}
+
+fn num(row: &HashMap<String, String>, key: &str) -> f64 {
+    row[key].parse().unwrap_or_else(|_| panic!("{key} = {:?} is not a number", row[key]))
+}
+
+/// A copy of the committed configs (methods, verdicts, peers) in `dir/configs`, its scenarios
+/// replaced by `scenarios` (file name, contents), and `extra` appended to methods.toml.
+fn configs_in(dir: &Path, scenarios: &[(&str, String)], extra: &str) -> PathBuf {
+    let configs = dir.join("configs");
+    std::fs::create_dir_all(configs.join("scenarios")).unwrap();
+    let root = support::workspace_root();
+    for file in ["methods.toml", "verdicts.toml", "peers.toml"] {
+        std::fs::copy(root.join("configs").join(file), configs.join(file)).unwrap();
+    }
+    let methods = std::fs::read_to_string(configs.join("methods.toml")).unwrap();
+    std::fs::write(configs.join("methods.toml"), format!("{methods}\n{extra}")).unwrap();
+    for (name, text) in scenarios {
+        std::fs::write(configs.join("scenarios").join(name), text).unwrap();
+    }
+    // `working_dir = ".."` of the committed entries is the workspace: give the copy the same layout.
+    std::os::unix::fs::symlink(root.join("external"), dir.join("external")).unwrap();
+    configs
+}
+
+/// The fenced block that follows `marker` in the README.
+fn readme_block(marker: &str) -> String {
+    let readme = std::fs::read_to_string(support::workspace_root().join("README.md")).unwrap();
+    let after = &readme[readme.find(marker).unwrap_or_else(|| panic!("README lacks {marker}"))..];
+    let start = after.find("```").unwrap();
+    let body = &after[start..];
+    let body = &body[body.find('\n').unwrap() + 1..];
+    let end = body.find("```").unwrap();
+    body[..end].lines().map(str::trim).collect::<Vec<_>>().join("\n")
+}
+
+#[test]
+fn the_readme_example_method_runs_as_written() {
+    let Some(python) = support::python() else { return };
+    // Step 1 of the README exports DEFORMBENCH_PYTHON; scripts/test has done so.
+    assert_eq!(std::env::var_os("DEFORMBENCH_PYTHON").map(PathBuf::from), Some(python));
+    let dir = tempfile::tempdir().unwrap();
+    let root = support::workspace_root();
+    let cylinder = std::fs::read_to_string(root.join("configs/scenarios/cylinder.toml")).unwrap();
+    let configs = configs_in(
+        dir.path(),
+        &[("cylinder.toml", cylinder)],
+        &readme_block("<!-- example-method-entry -->"),
+    );
+    let command = readme_block("<!-- example-method-run -->");
+    let args: Vec<&str> =
+        command.split_once("harness -- ").expect("a harness command").1.split_whitespace().collect();
+    let reports = dir.path().join("reports");
+    let mut full = args.clone();
+    full.extend(["--quiet", "--configs", configs.to_str().unwrap(), "--reports", reports.to_str().unwrap()]);
+    assert_eq!(run(&full).unwrap(), ExitCode::SUCCESS, "{command}");
+
+    let rows = csv_rows(&reports.join("results.csv"));
+    let example = row(&rows, "harmonic_displacement");
+    assert_eq!(example["origin"], "external");
+    assert!(!example["status"].starts_with("failed"), "{}", example["status"]);
+    assert!(num(example, "startup_s") > 0.0);
+    // A direct method that puts every handle on its target, exactly as the pipe carries it.
+    assert!(num(example, "handle_residual_over_diag") < 1e-12, "{}", example["handle_residual_over_diag"]);
+    assert!(
+        num(example, "e_theta_deg") > num(row(&rows, "arap"), "e_theta_deg"),
+        "no rotations: worse than arap"
+    );
+    assert_eq!(row(&rows, "arap")["origin"], "built-in");
+    assert!(reports.join("logs/cylinder-harmonic_displacement.stderr.txt").is_file());
+    let page = std::fs::read_to_string(reports.join("index.html")).unwrap();
+    assert!(page.contains("harmonic_displacement<span class=\"origin\""), "the page marks the external row");
+}
+
+/// Process ids of every running process whose command line contains `needle`.
+fn processes_with(needle: &str) -> Vec<u32> {
+    let mut pids = Vec::new();
+    for entry in std::fs::read_dir("/proc").unwrap().flatten() {
+        let Ok(pid) = entry.file_name().to_string_lossy().parse::<u32>() else { continue };
+        let Ok(cmdline) = std::fs::read(entry.path().join("cmdline")) else { continue };
+        let stat = std::fs::read_to_string(entry.path().join("stat")).unwrap_or_default();
+        let zombie = stat.rsplit_once(')').is_some_and(|(_, rest)| rest.trim_start().starts_with(['Z', 'X']));
+        if !zombie && String::from_utf8_lossy(&cmdline).replace('\0', " ").contains(needle) {
+            pids.push(pid);
+        }
+    }
+    pids
+}
+
+/// The fields of a results.json case that do not depend on timing.
+fn timeless(case: &serde_json::Value) -> serde_json::Value {
+    let mut c = case.clone();
+    let object = c.as_object_mut().unwrap();
+    for key in
+        ["precompute_s", "bind_s", "median_iteration_ms", "solve_s", "total_s", "phase_timings", "overhead"]
+    {
+        object.remove(key);
+    }
+    for step in object["steps"].as_array_mut().unwrap() {
+        for key in ["bind_s", "solve_s", "median_iteration_ms", "phase_timings"] {
+            step.as_object_mut().unwrap().remove(key);
+        }
+    }
+    for record in object["trace"].as_array_mut().unwrap() {
+        record.as_object_mut().unwrap().remove("seconds");
+    }
+    c
+}
+
+#[test]
+fn a_broken_method_beside_built_in_ones_fails_alone_and_leaves_nothing_running() {
+    let dir = tempfile::tempdir().unwrap();
+    let toy = support::workspace_root().join("tests/external/toy_method.py");
+    let pid_file = dir.path().join("grandchild.pid");
+    let toys = format!(
+        "[toy_crash]\ncommand = [\"python3\", \"{toy}\", \"crash-in-solve\"]\n\n\
+         [toy_hang]\ncommand = [\"python3\", \"{toy}\", \"hang\", \"{pid}\"]\ntimeout_s = 3\n\n\
+         [toy_nan]\ncommand = [\"python3\", \"{toy}\", \"nan\"]\n\n\
+         [toy_ok]\ncommand = [\"python3\", \"{toy}\", \"ok\"]\n",
+        toy = toy.display(),
+        pid = pid_file.display()
+    );
+    let scenario = |methods: &str| {
+        format!("name = \"bar\"\nprocedural = {{ shape = \"bar\", vertices = 800 }}\nmethods = [{methods}]\n")
+    };
+    let built_in = "\"laplacian\", \"arap\", \"isolines\"";
+    let with_toys = format!("{built_in}, \"toy_crash\", \"toy_hang\", \"toy_nan\", \"toy_ok\"");
+    let broken = configs_in(&dir.path().join("broken"), &[("bar.toml", scenario(&with_toys))], &toys);
+    let plain = configs_in(&dir.path().join("plain"), &[("bar.toml", scenario(built_in))], "");
+    let all = |configs: &Path, reports: &str| {
+        let reports = dir.path().join(reports);
+        let code = run(&[
+            "all",
+            "--quiet",
+            "--configs",
+            configs.to_str().unwrap(),
+            "--reports",
+            reports.to_str().unwrap(),
+        ]);
+        (code.unwrap(), reports)
+    };
+    let (code, broken_reports) = all(&broken, "broken-reports");
+    assert_eq!(code, ExitCode::from(harness::cli::EXIT_CASE_FAILED));
+    let (code, plain_reports) = all(&plain, "plain-reports");
+    assert_eq!(code, ExitCode::SUCCESS);
+
+    let rows = csv_rows(&broken_reports.join("results.csv"));
+    let status = |m: &str| row(&rows, m)["status"].clone();
+    for (method, needles) in [
+        (
+            "toy_crash",
+            &["failed: external method `toy_crash`: `solve`", "exit status: 3", "ZeroDivisionError"][..],
+        ),
+        ("toy_hang", &["failed: external method `toy_hang`: `solve`", "timeout of 3 s", "toy: solve"][..]),
+        ("toy_nan", &["failed: external method `toy_nan`: `solve`", "non-finite number (NaN)"][..]),
+    ] {
+        for n in needles {
+            assert!(status(method).contains(n), "{method}: `{n}` not in {}", status(method));
+        }
+    }
+    // The well-behaved toy moves only its handles; the verdict sees the tear like any method's.
+    assert!(status("toy_ok").starts_with("suspect: folds"), "{}", status("toy_ok"));
+    assert_eq!(row(&rows, "toy_ok")["origin"], "external");
+
+    // The built-in rows are those of a run without the toys, to the last bit.
+    let cases = |reports: &Path| -> Vec<serde_json::Value> {
+        let json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(reports.join("results.json")).unwrap()).unwrap();
+        json["cases"].as_array().unwrap().iter().filter(|c| c["origin"] == "built-in").map(timeless).collect()
+    };
+    let (with, without) = (cases(&broken_reports), cases(&plain_reports));
+    assert_eq!(with.len(), 3);
+    assert_eq!(with, without);
+
+    // Nothing outlives the run: neither a toy nor the grandchild the hanging one started.
+    let grandchild: u32 = std::fs::read_to_string(&pid_file).unwrap().trim().parse().unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(2);
+    while (!processes_with(&toy.display().to_string()).is_empty()
+        || std::path::Path::new(&format!("/proc/{grandchild}/cmdline")).exists()
+            && !processes_with("sleep 600").is_empty())
+        && std::time::Instant::now() < deadline
+    {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert_eq!(processes_with(&toy.display().to_string()), Vec::<u32>::new(), "toy processes left running");
+    let stat = std::fs::read_to_string(format!("/proc/{grandchild}/stat")).unwrap_or_default();
+    let alive = stat.rsplit_once(')').is_some_and(|(_, rest)| !rest.trim_start().starts_with(['Z', 'X']));
+    assert!(!alive, "the hanging toy's grandchild {grandchild} outlived the run");
+}
+
+#[test]
+fn peers_run_beside_arap_and_land_near_it() {
+    let Some(python) = support::python() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let bar = "name = \"bar\"\nprocedural = { shape = \"bar\", vertices = 1500 }\n".to_string();
+    let configs = configs_in(dir.path(), &[("bar.toml", bar)], "");
+    let reports = dir.path().join("reports");
+    let mut args =
+        vec!["run", "--peers", "--python", python.to_str().unwrap(), "--scenario", "bar", "--quiet"];
+    for m in ["arap", "libigl_arap", "libigl_biharmonic", "open3d_arap", "open3d_arap_smoothed"] {
+        args.extend(["--method", m]);
+    }
+    args.extend(["--configs", configs.to_str().unwrap(), "--reports", reports.to_str().unwrap()]);
+    assert_eq!(run(&args).unwrap(), ExitCode::SUCCESS);
+    let rows = csv_rows(&reports.join("results.csv"));
+    assert_eq!(rows.len(), 5);
+    for r in rows.iter().filter(|r| r["method"] != "arap") {
+        assert_eq!(r["origin"], "peer", "{}", r["method"]);
+        assert!(!r["status"].starts_with("failed"), "{}: {}", r["method"], r["status"]);
+    }
+    // The same energy to the same tolerance: the same shape, up to the weights (ours are the
+    // intrinsic Delaunay cotangents) and libigl's single-precision rotation fit.
+    let libigl = row(&rows, "libigl_arap");
+    assert!(num(libigl, "rms_to_arap_over_diag") < 1e-3, "{}", libigl["rms_to_arap_over_diag"]);
+    assert_eq!(libigl["converged"], "true");
+    // Linear: a twist it cannot follow without rotations.
+    assert!(num(row(&rows, "libigl_biharmonic"), "e_theta_deg") > num(row(&rows, "arap"), "e_theta_deg"));
+    let peers = std::fs::read_to_string(reports.join("peers.md")).unwrap();
+    assert!(peers.contains("| bar | "), "{peers}");
+    let page = std::fs::read_to_string(reports.join("index.html")).unwrap();
+    assert!(page.contains("Our arap against libigl's") && page.contains("<span class=\"origin\""));
+
+    // Without the Python the run says so and runs the rest.
+    let reports = dir.path().join("reports-without");
+    let args = [
+        "run",
+        "--peers",
+        "--python",
+        "/nonexistent/python",
+        "--scenario",
+        "bar",
+        "--method",
+        "arap",
+        "--quiet",
+        "--configs",
+        configs.to_str().unwrap(),
+        "--reports",
+        reports.to_str().unwrap(),
+    ];
+    assert_eq!(run(&args).unwrap(), ExitCode::SUCCESS);
+    assert_eq!(csv_rows(&reports.join("results.csv")).len(), 1);
+    let page = std::fs::read_to_string(reports.join("index.html")).unwrap();
+    assert!(page.contains("peers not run: the Python /nonexistent/python does not exist"));
+}
