@@ -9,7 +9,7 @@ stop at the same fixed point of the same energy (up to the weights: libigl's pla
 ours intrinsic-Delaunay by default). The factorization needs the constrained vertices, so it is
 timed in `bind`. libigl runs single-threaded here (IGL_NUM_THREADS=1).
 
-params: tolerance (1e-5), max_iterations (5000).
+params: tolerance (1e-5), max_iterations (3000).
 """
 
 import importlib.metadata
@@ -29,7 +29,7 @@ import deformbench_method as protocol  # noqa: E402
 class LibiglArap:
     def __init__(self, params):
         self.tolerance = float(params.get("tolerance", 1e-5))
-        self.max_iterations = int(params.get("max_iterations", 5000))
+        self.max_iterations = int(params.get("max_iterations", 3000))
 
     def precompute(self, V, F):
         self.V, self.F = V, F

@@ -11,7 +11,7 @@ use crate::metrics::METRICS;
 use crate::peers;
 use crate::pipeline::{self, GateRequest, Outcome, PublishOptions};
 use crate::regression::{self, GateOutcome};
-use crate::report::{peer_comparison, MeshFormat, MeshOutput};
+use crate::report::{MeshFormat, MeshOutput};
 use crate::scenario::load_specs;
 use crate::shard::Shard;
 use crate::suite::{self, SuiteOptions, SURVEY_DIR_ENV};
@@ -350,9 +350,8 @@ fn publish_and_print(
     let outcome = pipeline::publish(options, &mut run, publish, gate).context("publishing the run")?;
     println!("data: {}", run.data_source);
     print_table(&run.results);
-    let peers = peer_comparison::render_markdown(&peer_comparison::arap_against_libigl(&run.results));
-    if !peers.is_empty() {
-        println!("\n{peers}");
+    if !outcome.arap_against_libigl.is_empty() {
+        println!("\n{}", outcome.arap_against_libigl);
     }
     print_phases(&outcome);
     println!("reports: {} (open index.html)", options.reports_dir.display());

@@ -40,6 +40,9 @@ impl Origin {
 /// its `params` table).
 const EXTERNAL_KEYS: &[&str] = &["command", "working_dir", "timeout_s", "summary", "params"];
 
+/// The keys of a variant of a built-in method (`method = "arap"` with other `params`).
+const VARIANT_KEYS: &[&str] = &["method", "summary", "params"];
+
 /// An external method's entry, resolved: `command = ["program", "arg", …]` with `${VAR}` expanded,
 /// `working_dir` (relative to the file's directory; default that directory), `timeout_s` per
 /// request, a one-line `summary`, and `params`, sent to the program untouched.
@@ -62,6 +65,24 @@ pub struct PeerSetup {
     pub python: PathBuf,
 }
 
+/// What runs a configured method.
+#[derive(Clone)]
+pub enum Implementation {
+    /// The registered method of this name (a variant's `method`).
+    BuiltIn(&'static methods::registry::MethodEntry),
+    /// A program over the protocol.
+    External(ExternalEntry),
+}
+
+impl std::fmt::Debug for Implementation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Implementation::BuiltIn(entry) => write!(f, "BuiltIn({})", entry.name),
+            Implementation::External(e) => f.debug_tuple("External").field(e).finish(),
+        }
+    }
+}
+
 /// One method of a run.
 #[derive(Clone, Debug)]
 pub struct ConfiguredMethod {
@@ -69,17 +90,16 @@ pub struct ConfiguredMethod {
     pub origin: Origin,
     /// A built-in method's parameters (its table); an external method's `params`.
     pub params: toml::Table,
-    /// How to run it, for an external method.
-    pub external: Option<ExternalEntry>,
+    pub implementation: Implementation,
 }
 
 impl ConfiguredMethod {
     /// A fresh instance; an external method's program is started (its stderr appended to
     /// `stderr_log`).
     pub fn create(&self, stderr_log: Option<PathBuf>) -> Result<Box<dyn DeformationMethod>, MethodError> {
-        match &self.external {
-            None => methods::registry::create(&self.name, &self.params),
-            Some(e) => Ok(Box::new(ExternalMethod::start(ExternalSpec {
+        match &self.implementation {
+            Implementation::BuiltIn(entry) => (entry.create)(&self.params),
+            Implementation::External(e) => Ok(Box::new(ExternalMethod::start(ExternalSpec {
                 name: self.name.clone(),
                 program: e.program.clone(),
                 args: e.args.clone(),
@@ -94,10 +114,15 @@ impl ConfiguredMethod {
 
     /// One line: what it is.
     pub fn summary(&self) -> &str {
-        match &self.external {
-            None => methods::registry::find(&self.name).map_or("", |m| m.summary),
-            Some(e) => &e.summary,
+        match &self.implementation {
+            Implementation::BuiltIn(entry) => entry.summary,
+            Implementation::External(e) => &e.summary,
         }
+    }
+
+    /// Whether it runs in another process.
+    pub fn is_external(&self) -> bool {
+        matches!(self.implementation, Implementation::External(_))
     }
 }
 
@@ -111,7 +136,8 @@ pub struct MethodCatalog {
 
 impl MethodCatalog {
     /// Read and check `path` (`configs/methods.toml`): every top-level key is a built-in method with
-    /// parameters it accepts, or an external method with a `command`.
+    /// parameters it accepts, a variant of one (`method`, `params`), or an external method with a
+    /// `command`.
     pub fn load(path: &Path) -> Result<Self, HarnessError> {
         let mut methods: Vec<ConfiguredMethod> = methods::registry::METHODS
             .iter()
@@ -119,18 +145,18 @@ impl MethodCatalog {
                 name: m.name.to_string(),
                 origin: Origin::BuiltIn,
                 params: toml::Table::new(),
-                external: None,
+                implementation: Implementation::BuiltIn(m),
             })
             .collect();
         for (name, table) in read_tables(path)? {
             let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
-            if table.contains_key("command") {
+            if table.contains_key("command") || table.contains_key("method") {
                 if methods.iter().any(|m| m.name == name) {
                     return Err(config(format!(
-                        "`{name}` is a built-in method; an external one needs another name"
+                        "`{name}` is a built-in method; a new entry needs another name"
                     )));
                 }
-                methods.push(external(path, &name, &table, Origin::External, &[])?);
+                methods.push(entry(path, &name, &table, Origin::External, &[])?);
             } else {
                 // Building the method validates the name and every key.
                 methods::registry::create(&name, &table).map_err(|e| config(e.to_string()))?;
@@ -154,7 +180,7 @@ impl MethodCatalog {
                     message: format!("peer `{name}` has the name of a method of {}", self.path.display()),
                 });
             }
-            self.methods.push(external(path, &name, &table, Origin::Peer, &given)?);
+            self.methods.push(entry(path, &name, &table, Origin::Peer, &given)?);
         }
         Ok(())
     }
@@ -209,9 +235,9 @@ fn read_tables(path: &Path) -> Result<Vec<(String, toml::Table)>, HarnessError> 
     Ok(tables)
 }
 
-/// The external method `name` of `path` (its table `table`), `given` variables before the
-/// environment's.
-fn external(
+/// The entry `name` of `path` (its table `table`): a variant of a built-in method (`method`), or an
+/// external method (`command`, `given` variables expanded before the environment's) of `origin`.
+fn entry(
     path: &Path,
     name: &str,
     table: &toml::Table,
@@ -224,6 +250,31 @@ fn external(
     };
     if !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
         return Err(config("a method name is letters, digits, `_` and `-` (it names report files)".into()));
+    }
+    let params = match table.get("params") {
+        None => toml::Table::new(),
+        Some(toml::Value::Table(t)) => t.clone(),
+        Some(_) => return Err(config("`params` must be a table".into())),
+    };
+    if let Some(base) = table.get("method") {
+        if table.contains_key("command") {
+            return Err(config(
+                "give `method` (a variant of a built-in method) or `command`, not both".into(),
+            ));
+        }
+        if let Some(key) = table.keys().find(|k| !VARIANT_KEYS.contains(&k.as_str())) {
+            return Err(config(format!("unknown key `{key}` (a variant takes {})", VARIANT_KEYS.join(", "))));
+        }
+        let base = base.as_str().ok_or_else(|| config("`method` must be a method name".into()))?;
+        let builtin = methods::registry::find(base).map_err(|e| config(e.to_string()))?;
+        methods::registry::create(base, &params).map_err(|e| config(e.to_string()))?;
+        return Ok(ConfiguredMethod {
+            name: name.to_string(),
+            // Our own implementation, whichever file named it.
+            origin: Origin::BuiltIn,
+            params,
+            implementation: Implementation::BuiltIn(builtin),
+        });
     }
     if let Some(key) = table.keys().find(|k| !EXTERNAL_KEYS.contains(&k.as_str())) {
         return Err(config(format!(
@@ -277,18 +328,13 @@ fn external(
         Some(toml::Value::String(s)) => s.clone(),
         Some(_) => return Err(config("`summary` must be a string".into())),
     };
-    let params = match table.get("params") {
-        None => toml::Table::new(),
-        Some(toml::Value::Table(t)) => t.clone(),
-        Some(_) => return Err(config("`params` must be a table".into())),
-    };
     let json = serde_json::to_value(&params).map_err(|e| config(format!("params: {e}")))?;
     let mut command = command.into_iter();
     Ok(ConfiguredMethod {
         name: name.to_string(),
         origin,
         params,
-        external: Some(ExternalEntry {
+        implementation: Implementation::External(ExternalEntry {
             program: command.next().expect("non-empty"),
             args: command.collect(),
             working_dir,
@@ -322,7 +368,7 @@ mod tests {
         let builtin = methods::registry::METHODS.len();
         assert_eq!(&names[builtin..], &["zeta", "alpha"]);
         let zeta = catalog.get("zeta").unwrap();
-        let e = zeta.external.as_ref().unwrap();
+        let Implementation::External(e) = &zeta.implementation else { panic!("not external") };
         assert_eq!((e.program.as_str(), e.args.as_slice()), ("/usr/bin/env", &["x.py".to_string()][..]));
         assert_eq!(e.timeout, Duration::from_secs(5));
         assert_eq!(e.params, serde_json::json!({"k": 2, "name": "a"}));
@@ -346,5 +392,20 @@ mod tests {
         assert!(err.contains("letters, digits"), "{err}");
         let err = load("[nosuch]\nk = 1\n").unwrap_err();
         assert!(err.contains("unknown method `nosuch`"), "{err}");
+        let err = load("[v]\nmethod = \"arap\"\n[v.params]\nwieghts = \"cotan\"\n").unwrap_err();
+        assert!(err.contains("[v]") && err.contains("wieghts"), "{err}");
+        let err = load("[v]\nmethod = \"nosuch\"\n").unwrap_err();
+        assert!(err.contains("unknown method `nosuch`"), "{err}");
+    }
+
+    #[test]
+    fn a_variant_runs_a_built_in_method_with_its_own_parameters() {
+        let catalog =
+            load("[arap_cotan]\nmethod = \"arap\"\n[arap_cotan.params]\nweights = \"cotan\"\n").unwrap();
+        let variant = catalog.get("arap_cotan").unwrap();
+        assert!(matches!(variant.implementation, Implementation::BuiltIn(e) if e.name == "arap"));
+        assert_eq!(variant.origin, Origin::BuiltIn);
+        assert_eq!(variant.params.get("weights").and_then(|v| v.as_str()), Some("cotan"));
+        assert!(catalog.get("arap").unwrap().params.is_empty(), "the base keeps its own parameters");
     }
 }

@@ -8,7 +8,7 @@ use std::time::Instant;
 use crate::case::CaseResult;
 use crate::error::HarnessError;
 use crate::regression::{self, BaselineKind, GateOutcome};
-use crate::report::{self, html, plots, render, MeshOutput};
+use crate::report::{self, html, peer_comparison, plots, render, MeshOutput};
 use crate::suite::{self, SuiteOptions, SuiteRun};
 use crate::{peers, shard::Shard};
 
@@ -116,6 +116,8 @@ pub struct PublishOptions {
 pub struct Outcome {
     /// The regression gate's findings, or why it did not compare.
     pub gate: GateOutcome,
+    /// Our ARAP against libigl's (markdown, `peers.md`), empty without the peers.
+    pub arap_against_libigl: String,
     /// Cases whose status is `suspect`.
     pub suspect: usize,
     /// Cases whose status is `unfinished` (stopped at their iteration cap).
@@ -173,14 +175,17 @@ pub fn publish(
         GateRequest::Skip(reason) => GateOutcome::NotChecked(reason),
     };
     let table1 = report::render_table1(&run.results);
+    let peers =
+        peer_comparison::render_markdown(&peer_comparison::arap_against_libigl(&run.results, &run.scenarios));
     html::write_index(
         dir,
-        &html::render_index(&run.results, &run.data_source, &images, &table1, &outcome, &run.notes),
+        &html::render_index(&run.results, &run.data_source, &images, &table1, &peers, &outcome, &run.notes),
     )?;
     timed(RunPhase::GateAndIndex, start);
 
     Ok(Outcome {
         gate: outcome,
+        arap_against_libigl: peers,
         suspect: run.results.iter().filter(|r| r.status.is_suspect()).count(),
         unfinished: run.results.iter().filter(|r| r.status.is_unfinished()).count(),
         failed: run.results.iter().filter(|r| r.status.is_failed()).count(),

@@ -20,6 +20,10 @@ pub const REFERENCE_METHOD: &str = methods::registry::ARAP;
 /// sets their times to convergence side by side.
 pub const PEER_OF_REFERENCE: &str = "libigl_arap";
 
+/// Our reference with the peer's weights (plain cotangents; configs/peers.toml), so the peer's
+/// shape can be checked against ours like for like.
+pub const LIKE_FOR_LIKE_REFERENCE: &str = "arap_cotan";
+
 /// Environment variable naming the survey data directory (same as `--survey-dir`).
 pub const SURVEY_DIR_ENV: &str = "DEFORM_SURVEY_DIR";
 
@@ -241,7 +245,7 @@ fn run_plan(
                     .and_then(|c| c.positions.as_deref())
                     .map_or(Reference::Missing, Reference::Of)
             };
-            let stderr_log = method.external.as_ref().map(|_| {
+            let stderr_log = method.is_external().then(|| {
                 options
                     .reports_dir
                     .join("logs")

@@ -11,7 +11,6 @@ use crate::config::Origin;
 use crate::error::HarnessError;
 use crate::metrics::METRICS;
 use crate::regression::GateOutcome;
-use crate::report::peer_comparison;
 
 /// Escape text for HTML element content and attribute values.
 fn escape(text: &str) -> String {
@@ -28,12 +27,13 @@ fn number(v: f64, digits: usize) -> String {
 
 /// The page for `results` (with `data_source`), linking `images` (paths relative to the report
 /// directory: plots and figures) and showing `table1_markdown` (HIRM's Table 1 as written to
-/// `table1.md`).
+/// `table1.md`) and `peers` (our ARAP against libigl's, `peers.md`; empty: none).
 pub fn render_index(
     results: &[CaseResult],
     data_source: &str,
     images: &[PathBuf],
     table1_markdown: &str,
+    peers: &str,
     gate: &GateOutcome,
     notes: &[String],
 ) -> String {
@@ -165,7 +165,6 @@ pub fn render_index(
         );
     }
     page.push_str("</table></div>\n");
-    let peers = peer_comparison::render_markdown(&peer_comparison::arap_against_libigl(results));
     if !peers.is_empty() {
         page.push_str("<h2 id=\"arap-libigl\">Our arap against libigl's</h2>\n");
         page.push_str(&markdown_table(&peers));

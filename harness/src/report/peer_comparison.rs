@@ -1,27 +1,41 @@
-//! Our `arap` against libigl's on each test (`harness all --peers`): both run the plain energy to
-//! the same step tolerance, so they should stop at the same shape; the table gives how far apart
-//! the shapes are and the ratio of the times to convergence. Written as `peers.md` and on the page.
+//! Our `arap` against libigl's on each test (`harness all --peers`). Both run Sorkine & Alexa's
+//! spokes energy to the same step tolerance; libigl's uses the plain cotangent weights, ours the
+//! intrinsic Delaunay ones by default, so the peers add `arap_cotan` (our `arap` with libigl's
+//! weights) as the like-for-like reference: libigl's shape should be ours to the tolerance. The
+//! table gives the distances and the ratio of the times to convergence. Written as `peers.md` and
+//! on the page.
 
 use std::fmt::Write as _;
 
 use crate::case::CaseResult;
-use crate::suite::{PEER_OF_REFERENCE, REFERENCE_METHOD};
+use crate::scenario::LoadedScenario;
+use crate::suite::{LIKE_FOR_LIKE_REFERENCE, PEER_OF_REFERENCE, REFERENCE_METHOD};
+
+/// One of our ARAP rows set against libigl's on one test.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Side {
+    pub iterations: usize,
+    /// Every bind and solve of the case: the wait from a handle set to the converged shape.
+    pub seconds: f64,
+    pub converged: bool,
+    /// `seconds` over libigl's: below 1, ours is faster.
+    pub ratio: f64,
+    /// RMS distance of libigl's result from this one, over the rest bounding-box diagonal.
+    pub rms_over_diag: f64,
+}
 
 /// One test with both ARAPs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ArapAgainstLibigl {
     pub scenario: String,
     pub vertices: usize,
-    pub ours_iterations: usize,
-    /// Every bind and solve of the case: the wait from a handle set to the converged shape.
-    pub ours_s: f64,
     pub libigl_iterations: usize,
     pub libigl_s: f64,
-    /// `ours_s / libigl_s`: below 1, ours is faster.
-    pub ratio: f64,
-    /// RMS distance of libigl's result from ours over the rest diagonal.
-    pub rms_over_diag: f64,
-    pub both_converged: bool,
+    pub libigl_converged: bool,
+    /// Our `arap` (its configured weights).
+    pub ours: Side,
+    /// `arap_cotan`, when the run has it.
+    pub like_for_like: Option<Side>,
 }
 
 /// Bind plus solve over every step: the time to convergence after each handle edit, summed.
@@ -29,29 +43,51 @@ fn time_to_convergence(case: &CaseResult) -> f64 {
     case.steps.iter().map(|s| s.bind_s + s.solve_s).sum()
 }
 
-/// Every scenario where both `arap` and `libigl_arap` have a result, in order.
-pub fn arap_against_libigl(results: &[CaseResult]) -> Vec<ArapAgainstLibigl> {
-    let ok = |r: &&CaseResult| !r.status.is_failed();
-    results
+/// RMS distance between two `#V x 3` results over `diagonal`.
+fn rms_distance(a: &[[f64; 3]], b: &[[f64; 3]], diagonal: f64) -> f64 {
+    let sum: f64 = a
         .iter()
-        .filter(|r| r.method == PEER_OF_REFERENCE)
-        .filter(ok)
-        .filter_map(|peer| {
-            let ours = results
-                .iter()
-                .filter(ok)
-                .find(|r| r.method == REFERENCE_METHOD && r.scenario == peer.scenario)?;
-            let (ours_s, libigl_s) = (time_to_convergence(ours), time_to_convergence(peer));
+        .zip(b)
+        .map(|(p, q)| {
+            let d = meshes::vector::sub(*p, *q);
+            meshes::vector::dot(d, d)
+        })
+        .sum();
+    (sum / a.len().max(1) as f64).sqrt() / diagonal
+}
+
+/// Every scenario of `scenarios` where `arap` and `libigl_arap` both have a result, in order.
+pub fn arap_against_libigl(results: &[CaseResult], scenarios: &[LoadedScenario]) -> Vec<ArapAgainstLibigl> {
+    let find = |scenario: &str, method: &str| {
+        results
+            .iter()
+            .find(|r| r.scenario == scenario && r.method == method && !r.status.is_failed())
+            .and_then(|r| Some((r, r.positions.as_deref()?)))
+    };
+    scenarios
+        .iter()
+        .filter_map(|s| {
+            let name = s.spec.name.as_str();
+            let (libigl, libigl_positions) = find(name, PEER_OF_REFERENCE)?;
+            let diagonal = s.mesh.bbox_diagonal();
+            let libigl_s = time_to_convergence(libigl);
+            let side = |method: &str| {
+                find(name, method).map(|(r, positions)| Side {
+                    iterations: r.iterations,
+                    seconds: time_to_convergence(r),
+                    converged: r.converged,
+                    ratio: time_to_convergence(r) / libigl_s,
+                    rms_over_diag: rms_distance(libigl_positions, positions, diagonal),
+                })
+            };
             Some(ArapAgainstLibigl {
-                scenario: peer.scenario.clone(),
-                vertices: peer.vertices,
-                ours_iterations: ours.iterations,
-                ours_s,
-                libigl_iterations: peer.iterations,
+                scenario: name.to_string(),
+                vertices: libigl.vertices,
+                libigl_iterations: libigl.iterations,
                 libigl_s,
-                ratio: ours_s / libigl_s,
-                rms_over_diag: peer.metric(crate::metrics::Metric::RmsToArap),
-                both_converged: ours.converged && peer.converged,
+                libigl_converged: libigl.converged,
+                ours: side(REFERENCE_METHOD)?,
+                like_for_like: side(LIKE_FOR_LIKE_REFERENCE),
             })
         })
         .collect()
@@ -62,25 +98,40 @@ pub fn render_markdown(rows: &[ArapAgainstLibigl]) -> String {
     if rows.is_empty() {
         return String::new();
     }
-    let mut out = String::from(
-        "# Our `arap` against libigl's ARAP\n\nBoth to a step below 1e-5 of the rest diagonal; time = bind + \
-         solve of every edit step (libigl's `arap_precomputation` needs the handles, so it is bind). Ratio below \
-         1: ours is faster.\n\n| test | #V | arap iterations | arap s | libigl iterations | libigl s | ratio | RMS \
-         distance / diag | both converged |\n|---|---:|---:|---:|---:|---:|---:|---:|---|\n",
+    let mut out = format!(
+        "# Our ARAP against libigl's\n\nAll three run the spokes energy to a step below 1e-5 of the rest diagonal \
+         (libigl one iteration per call). `{REFERENCE_METHOD}` has our default weights (intrinsic Delaunay cotangents), \
+         `{LIKE_FOR_LIKE_REFERENCE}` libigl's (plain cotangents): the like-for-like comparison. Time = bind + solve of \
+         every edit step (libigl's `arap_precomputation` needs the handles, so it is bind); ratio = ours / libigl's, \
+         below 1 ours is faster. Distance = RMS of libigl's result from ours / rest diagonal. A `*` marks a row \
+         stopped at its iteration cap.\n\n\
+         | test | #V | libigl iterations | libigl s | {REFERENCE_METHOD} iterations | s | ratio | distance | \
+         {LIKE_FOR_LIKE_REFERENCE} iterations | s | ratio | distance |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n"
     );
+    let cap = |converged: bool| if converged { "" } else { "*" };
+    let side = |s: Option<&Side>| match s {
+        Some(s) => format!(
+            "{}{} | {:.3} | {:.2} | {:.1e}",
+            s.iterations,
+            cap(s.converged),
+            s.seconds,
+            s.ratio,
+            s.rms_over_diag
+        ),
+        None => "– | – | – | –".to_string(),
+    };
     for r in rows {
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {:.3} | {} | {:.3} | {:.2} | {:.1e} | {} |",
+            "| {} | {} | {}{} | {:.3} | {} | {} |",
             r.scenario,
             r.vertices,
-            r.ours_iterations,
-            r.ours_s,
             r.libigl_iterations,
+            cap(r.libigl_converged),
             r.libigl_s,
-            r.ratio,
-            r.rms_over_diag,
-            if r.both_converged { "yes" } else { "no" }
+            side(Some(&r.ours)),
+            side(r.like_for_like.as_ref()),
         );
     }
     out
@@ -89,45 +140,27 @@ pub fn render_markdown(rows: &[ArapAgainstLibigl]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::case::StepRecord;
-
-    fn case(scenario: &str, method: &str, bind_s: f64, solve_s: f64, iterations: usize) -> CaseResult {
-        let mut c = CaseResult::empty(scenario, method, "survey", 10, 16);
-        c.iterations = iterations;
-        c.converged = true;
-        c.steps.push(StepRecord {
-            step: 1,
-            handles: 2,
-            constrained_vertices: 3,
-            bind_s,
-            solve_s,
-            iterations,
-            converged: true,
-            final_step: 1e-6,
-            median_iteration_ms: 1.0,
-            phase_timings: Vec::new(),
-        });
-        c
-    }
 
     #[test]
-    fn the_ratio_is_ours_over_libigls_time_to_convergence_per_test() {
-        let mut peer = case("bar", PEER_OF_REFERENCE, 0.5, 3.5, 2000);
-        peer.quality.set(crate::metrics::Metric::RmsToArap, Some(2e-4));
-        let results = vec![
-            case("bar", REFERENCE_METHOD, 0.1, 0.9, 200),
-            peer,
-            case("cactus", REFERENCE_METHOD, 0.1, 0.9, 200),
-            case("bar", "hirm", 0.1, 0.1, 10),
-        ];
-        let rows = arap_against_libigl(&results);
-        assert_eq!(rows.len(), 1, "cactus has no libigl row");
-        let r = &rows[0];
-        assert_eq!((r.scenario.as_str(), r.ours_iterations, r.libigl_iterations), ("bar", 200, 2000));
-        assert!((r.ratio - 0.25).abs() < 1e-12, "{}", r.ratio);
-        assert_eq!(r.rms_over_diag, 2e-4);
-        assert!(render_markdown(&rows)
-            .contains("| bar | 10 | 200 | 1.000 | 2000 | 4.000 | 0.25 | 2.0e-4 | yes |"));
+    fn a_row_sets_ratios_and_distances_against_libigl() {
+        let rows = vec![ArapAgainstLibigl {
+            scenario: "bar".into(),
+            vertices: 10,
+            libigl_iterations: 2000,
+            libigl_s: 4.0,
+            libigl_converged: true,
+            ours: Side { iterations: 200, seconds: 1.0, converged: true, ratio: 0.25, rms_over_diag: 2e-3 },
+            like_for_like: None,
+        }];
+        let md = render_markdown(&rows);
+        assert!(
+            md.contains("| bar | 10 | 2000 | 4.000 | 200 | 1.000 | 0.25 | 2.0e-3 | – | – | – | – |"),
+            "{md}"
+        );
         assert!(render_markdown(&[]).is_empty());
+        assert_eq!(
+            rms_distance(&[[0.0; 3], [3.0, 4.0, 0.0]], &[[0.0; 3], [0.0; 3]], 2.0),
+            (12.5f64).sqrt() / 2.0
+        );
     }
 }

@@ -322,8 +322,9 @@ pub fn write_reports(
     write_bytes(&dir.join("convergence.csv"), &render_convergence(results)?)?;
     write_bytes(&dir.join("handle_updates.csv"), &render_handle_updates(results)?)?;
     write_bytes(&dir.join("table1.md"), render_table1(results).as_bytes())?;
-    let peers =
-        super::peer_comparison::render_markdown(&super::peer_comparison::arap_against_libigl(results));
+    let peers = super::peer_comparison::render_markdown(&super::peer_comparison::arap_against_libigl(
+        results, scenarios,
+    ));
     if !peers.is_empty() {
         write_bytes(&dir.join("peers.md"), peers.as_bytes())?;
     }
