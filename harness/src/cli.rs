@@ -285,7 +285,7 @@ where
                 } else {
                     format!("[{}] ", m.origin.label())
                 };
-                println!("  {:<14} {origin}{}", m.name, m.summary());
+                println!("  {:<14} {origin}{}", m.name, m.summary);
             }
             println!("scenarios ({}):", options.configs_dir.join("scenarios").display());
             for s in load_specs(&options.configs_dir.join("scenarios"))? {

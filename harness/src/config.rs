@@ -45,14 +45,13 @@ const VARIANT_KEYS: &[&str] = &["method", "summary", "params"];
 
 /// An external method's entry, resolved: `command = ["program", "arg", …]` with `${VAR}` expanded,
 /// `working_dir` (relative to the file's directory; default that directory), `timeout_s` per
-/// request, a one-line `summary`, and `params`, sent to the program untouched.
+/// request, and `params`, sent to the program untouched.
 #[derive(Clone, Debug)]
 pub struct ExternalEntry {
     pub program: String,
     pub args: Vec<String>,
     pub working_dir: PathBuf,
     pub timeout: Duration,
-    pub summary: String,
     pub params: serde_json::Value,
 }
 
@@ -91,6 +90,8 @@ pub struct ConfiguredMethod {
     /// A built-in method's parameters (its table); an external method's `params`.
     pub params: toml::Table,
     pub implementation: Implementation,
+    /// One line: what it is (`list`).
+    pub summary: String,
 }
 
 impl ConfiguredMethod {
@@ -109,14 +110,6 @@ impl ConfiguredMethod {
                 params: e.params.clone(),
                 stderr_log,
             })?)),
-        }
-    }
-
-    /// One line: what it is.
-    pub fn summary(&self) -> &str {
-        match &self.implementation {
-            Implementation::BuiltIn(entry) => entry.summary,
-            Implementation::External(e) => &e.summary,
         }
     }
 
@@ -146,6 +139,7 @@ impl MethodCatalog {
                 origin: Origin::BuiltIn,
                 params: toml::Table::new(),
                 implementation: Implementation::BuiltIn(m),
+                summary: m.summary.to_string(),
             })
             .collect();
         for (name, table) in read_tables(path)? {
@@ -256,6 +250,11 @@ fn entry(
         Some(toml::Value::Table(t)) => t.clone(),
         Some(_) => return Err(config("`params` must be a table".into())),
     };
+    let summary = match table.get("summary") {
+        None => None,
+        Some(toml::Value::String(s)) => Some(s.clone()),
+        Some(_) => return Err(config("`summary` must be a string".into())),
+    };
     if let Some(base) = table.get("method") {
         if table.contains_key("command") {
             return Err(config(
@@ -272,6 +271,7 @@ fn entry(
             name: name.to_string(),
             // Our own implementation, whichever file named it.
             origin: Origin::BuiltIn,
+            summary: summary.unwrap_or_else(|| format!("`{base}` with {params}").replace('\n', ", ")),
             params,
             implementation: Implementation::BuiltIn(builtin),
         });
@@ -323,23 +323,19 @@ fn entry(
             _ => return Err(config("`timeout_s` must be a positive number of seconds".into())),
         },
     };
-    let summary = match table.get("summary") {
-        None => format!("external program `{}`", command.join(" ")),
-        Some(toml::Value::String(s)) => s.clone(),
-        Some(_) => return Err(config("`summary` must be a string".into())),
-    };
+    let summary = summary.unwrap_or_else(|| format!("external program `{}`", command.join(" ")));
     let json = serde_json::to_value(&params).map_err(|e| config(format!("params: {e}")))?;
     let mut command = command.into_iter();
     Ok(ConfiguredMethod {
         name: name.to_string(),
         origin,
         params,
+        summary,
         implementation: Implementation::External(ExternalEntry {
             program: command.next().expect("non-empty"),
             args: command.collect(),
             working_dir,
             timeout,
-            summary,
             params: json,
         }),
     })

@@ -95,9 +95,12 @@ pub fn prepare(options: &SuiteOptions) -> Result<(RunConfig, Vec<LoadedScenario>
     let catalog = load_catalog(options)?;
     let rules = VerdictRules::load(&options.configs_dir.join("verdicts.toml"))?;
     for m in &options.methods {
-        catalog
-            .find(m)
-            .map_err(|message| HarnessError::Config { path: catalog.path().to_path_buf(), message })?;
+        catalog.find(m).map_err(|message| {
+            let peers = options.configs_dir.join("peers.toml");
+            let is_peer = std::fs::read_to_string(&peers).is_ok_and(|t| t.contains(&format!("[{m}]")));
+            let hint = if is_peer && options.peers.is_none() { " (a peer: add --peers)" } else { "" };
+            HarnessError::Config { path: catalog.path().to_path_buf(), message: format!("{message}{hint}") }
+        })?;
     }
     let specs = select_specs(options)?;
     for spec in &specs {
