@@ -142,7 +142,7 @@ fn a_broken_method_beside_built_in_ones_fails_alone_and_leaves_nothing_running()
     let pid_file = dir.path().join("grandchild.pid");
     let toys = format!(
         "[toy_crash]\ncommand = [\"python3\", \"{toy}\", \"crash-in-solve\"]\n\n\
-         [toy_hang]\ncommand = [\"python3\", \"{toy}\", \"hang\", \"{pid}\"]\ntimeout_s = 3\n\n\
+         [toy_hang]\ncommand = [\"python3\", \"{toy}\", \"hang\", \"{pid}\"]\ntimeout_s = 5\n\n\
          [toy_nan]\ncommand = [\"python3\", \"{toy}\", \"nan\"]\n\n\
          [toy_ok]\ncommand = [\"python3\", \"{toy}\", \"ok\"]\n",
         toy = toy.display(),
@@ -179,7 +179,7 @@ fn a_broken_method_beside_built_in_ones_fails_alone_and_leaves_nothing_running()
             "toy_crash",
             &["failed: external method `toy_crash`: `solve`", "exit status: 3", "ZeroDivisionError"][..],
         ),
-        ("toy_hang", &["failed: external method `toy_hang`: `solve`", "timeout of 3 s", "toy: solve"][..]),
+        ("toy_hang", &["failed: external method `toy_hang`: `solve`", "timeout of 5 s", "toy: solve"][..]),
         ("toy_nan", &["failed: external method `toy_nan`: `solve`", "non-finite number (NaN)"][..]),
     ] {
         for n in needles {

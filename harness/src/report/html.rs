@@ -284,7 +284,7 @@ fn markdown_table(markdown: &str) -> String {
                 in_table = false;
             }
             if !line.is_empty() && !line.starts_with('#') {
-                let _ = writeln!(out, "<p>{}</p>", escape(line));
+                let _ = writeln!(out, "<p>{}</p>", inline_code(&escape(line)));
             }
         }
     }
@@ -294,9 +294,38 @@ fn markdown_table(markdown: &str) -> String {
     out
 }
 
+/// Markdown's `code` spans as `<code>` (an unpaired backtick stays).
+fn inline_code(text: &str) -> String {
+    let parts: Vec<&str> = text.split('`').collect();
+    if parts.len() % 2 == 0 {
+        return text.to_string();
+    }
+    let mut out = String::new();
+    for (i, part) in parts.iter().enumerate() {
+        if i % 2 == 1 {
+            let _ = write!(out, "<code>{part}</code>");
+        } else {
+            out.push_str(part);
+        }
+    }
+    out
+}
+
 /// Write `index.html` under `dir` atomically.
 pub fn write_index(dir: &Path, page: &str) -> Result<PathBuf, HarnessError> {
     let path = dir.join("index.html");
     meshes::io::atomic_write(&path, |w| w.write_all(page.as_bytes()).map_err(meshes::MeshError::from))?;
     Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn code_spans_become_code_elements() {
+        assert_eq!(inline_code("a `b` c `d`"), "a <code>b</code> c <code>d</code>");
+        assert_eq!(inline_code("one ` tick"), "one ` tick");
+        assert_eq!(markdown_table("see `x`\n"), "<p>see <code>x</code></p>\n");
+    }
 }
