@@ -682,6 +682,11 @@ fn shards_merged_equal_one_run_to_the_last_digit() {
     let merged = read_json(&work.path().join("merged/results.json"));
     assert_eq!(whole["data_source"], merged["data_source"]);
     assert!(merged.get("shard").is_none(), "the merged report is whole");
+    // The merge keeps each part's record, in part order.
+    let parts = merged["provenance"]["parts"].as_array().expect("the parts' records");
+    assert_eq!(parts.len(), 3);
+    assert!(parts.iter().all(|p| p["run"]["command_line"].as_array().unwrap().iter().any(|a| a == "--shard")));
+    assert!(whole["provenance"].get("parts").is_none());
     let (a, b) = (whole["cases"].as_array().unwrap(), merged["cases"].as_array().unwrap());
     assert_eq!(a.len(), 9);
     assert_eq!(a.len(), b.len());

@@ -197,7 +197,8 @@ pub enum Reference<'a> {
     Missing,
 }
 
-/// Run `method` (a fresh instance; an external method's stderr goes to `stderr_log`) on
+/// Run `method` (a fresh instance; an external method's stderr goes to `stderr_log`, and its thread
+/// variables say `threads`) on
 /// `scenario`, measure the result against `rest` (the scenario's rest geometry) and `reference`,
 /// and judge it by `rules`. A method error becomes a `failed` result; it does not abort the run.
 pub fn run_case(
@@ -205,6 +206,7 @@ pub fn run_case(
     rest: &RestGeometry,
     method: &ConfiguredMethod,
     stderr_log: Option<std::path::PathBuf>,
+    threads: usize,
     rules: &VerdictRules,
     reference: Reference<'_>,
 ) -> CaseResult {
@@ -226,7 +228,7 @@ pub fn run_case(
     let cap = params.get("max_iterations").and_then(toml::Value::as_integer).map(|c| c as usize);
     let tolerance = params.get("tolerance").and_then(toml::Value::as_float);
     let outcome = (|| -> Result<Vec<String>, methods::MethodError> {
-        let mut m = method.create(stderr_log)?;
+        let mut m = method.create(stderr_log, threads)?;
         result.startup_s = m.startup_seconds().unwrap_or(f64::NAN);
         result.about = m.about();
         let start = Instant::now();

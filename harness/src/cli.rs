@@ -175,6 +175,11 @@ struct Common {
     /// Hide the progress bar.
     #[arg(long)]
     quiet: bool,
+    /// Worker threads of every method: our methods' thread pool, and OMP_NUM_THREADS,
+    /// OPENBLAS_NUM_THREADS, MKL_NUM_THREADS and IGL_NUM_THREADS of external programs
+    /// [default: every logical core]. `--threads 1` is like for like with single-threaded peers.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    threads: Option<u32>,
 }
 
 #[derive(Args, Clone)]
@@ -195,7 +200,7 @@ impl Meshes {
 }
 
 impl Common {
-    fn options(&self, scenarios: Vec<String>, methods: Vec<String>) -> SuiteOptions {
+    fn options(&self, scenarios: Vec<String>, methods: Vec<String>, command_line: &[String]) -> SuiteOptions {
         let root = suite::workspace_root();
         SuiteOptions {
             configs_dir: self.configs.clone().unwrap_or_else(|| root.join("configs")),
@@ -205,6 +210,8 @@ impl Common {
             scenarios,
             methods,
             peers: None,
+            threads: self.threads.map_or_else(crate::threads::default_threads, |t| t as usize),
+            command_line: command_line.to_vec(),
             progress: !self.quiet,
         }
     }
@@ -224,10 +231,12 @@ where
     I: IntoIterator<Item = T>,
     T: Into<std::ffi::OsString> + Clone,
 {
+    let args: Vec<std::ffi::OsString> = args.into_iter().map(Into::into).collect();
+    let command_line: Vec<String> = args.iter().map(|a| a.to_string_lossy().into_owned()).collect();
     let cli = Cli::parse_from(args);
     match cli.command {
         Command::All { common, peers, meshes, gate, no_check, shard } => {
-            let mut options = common.options(Vec::new(), Vec::new());
+            let mut options = common.options(Vec::new(), Vec::new(), &command_line);
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             if let Some(shard) = shard {
                 return run_shard(&options, shard);
@@ -243,14 +252,14 @@ where
             publish_and_print(&options, run, &publish, gate)
         }
         Command::Merge { partials, common, meshes, gate } => {
-            let options = common.options(Vec::new(), Vec::new());
+            let options = common.options(Vec::new(), Vec::new(), &command_line);
             let run = suite::merge(&options, &partials).context("merging partial reports")?;
             let gate = GateRequest::for_suite(&options, gate.baseline);
             let publish = PublishOptions { peer_python: None, meshes: meshes.output() };
             publish_and_print(&options, run, &publish, gate)
         }
         Command::Run { methods, scenario, common, peers, meshes } => {
-            let mut options = common.options(vec![scenario], methods);
+            let mut options = common.options(vec![scenario], methods, &command_line);
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             let publish = PublishOptions { peer_python: peers.python()?, meshes: meshes.output() };
             let mut run = suite::run(&options).context("preparing the run")?;
@@ -263,20 +272,20 @@ where
             )
         }
         Command::Check { common, gate } => {
-            let dir = common.options(Vec::new(), Vec::new()).reports_dir;
+            let dir = common.options(Vec::new(), Vec::new(), &command_line).reports_dir;
             match pipeline::check(&dir, gate.baseline.as_deref())? {
                 GateOutcome::Checked { baseline, findings } => Ok(print_findings(&findings, &baseline)),
                 GateOutcome::NotChecked(reason) => anyhow::bail!("{reason}"),
             }
         }
         Command::Baseline { common, gate } => {
-            let dir = common.options(Vec::new(), Vec::new()).reports_dir;
+            let dir = common.options(Vec::new(), Vec::new(), &command_line).reports_dir;
             let (path, cases) = pipeline::write_baseline(&dir, gate.baseline.as_deref())?;
             println!("baseline: {cases} cases from {} written to {}", dir.display(), path.display());
             Ok(ExitCode::SUCCESS)
         }
         Command::List(common) => {
-            let options = common.options(Vec::new(), Vec::new());
+            let options = common.options(Vec::new(), Vec::new(), &command_line);
             println!("methods ({}):", options.configs_dir.join("methods.toml").display());
             let catalog = suite::load_catalog(&options)?;
             for m in catalog.methods() {
@@ -347,8 +356,12 @@ fn publish_and_print(
     for note in &run.notes {
         eprintln!("note: {note}");
     }
-    let outcome = pipeline::publish(options, &mut run, publish, gate).context("publishing the run")?;
+    // The reports' own parallel work (the figures) keeps to the run's threads too.
+    let pool = crate::threads::pool(options.threads)?;
+    let outcome =
+        pool.install(|| pipeline::publish(options, &mut run, publish, gate)).context("publishing the run")?;
     println!("data: {}", run.data_source);
+    println!("{}", run.provenance.summary());
     print_table(&run.results);
     if !outcome.arap_against_libigl.is_empty() {
         println!("\n{}", outcome.arap_against_libigl);

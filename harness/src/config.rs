@@ -95,9 +95,13 @@ pub struct ConfiguredMethod {
 }
 
 impl ConfiguredMethod {
-    /// A fresh instance; an external method's program is started (its stderr appended to
-    /// `stderr_log`).
-    pub fn create(&self, stderr_log: Option<PathBuf>) -> Result<Box<dyn DeformationMethod>, MethodError> {
+    /// A fresh instance; an external method's program is started (its stderr written to
+    /// `stderr_log`, its thread variables set to `threads`).
+    pub fn create(
+        &self,
+        stderr_log: Option<PathBuf>,
+        threads: usize,
+    ) -> Result<Box<dyn DeformationMethod>, MethodError> {
         match &self.implementation {
             Implementation::BuiltIn(entry) => (entry.create)(&self.params),
             Implementation::External(e) => Ok(Box::new(ExternalMethod::start(ExternalSpec {
@@ -105,7 +109,7 @@ impl ConfiguredMethod {
                 program: e.program.clone(),
                 args: e.args.clone(),
                 working_dir: Some(e.working_dir.clone()),
-                env: Vec::new(),
+                env: crate::threads::external_environment(threads),
                 timeout: e.timeout,
                 params: e.params.clone(),
                 stderr_log,

@@ -8,11 +8,13 @@ pub mod error;
 pub mod metrics;
 pub mod peers;
 pub mod pipeline;
+pub mod provenance;
 pub mod regression;
 pub mod report;
 pub mod scenario;
 pub mod shard;
 pub mod suite;
+pub mod threads;
 pub mod variables;
 pub mod verdict;
 

@@ -156,7 +156,14 @@ pub fn publish(
 
     let dir = &options.reports_dir;
     let start = Instant::now();
-    report::write_reports(dir, &run.results, &run.scenarios, &run.data_source, &publish.meshes)?;
+    report::write_reports(
+        dir,
+        &run.results,
+        &run.scenarios,
+        &run.data_source,
+        &run.provenance,
+        &publish.meshes,
+    )?;
     timed(RunPhase::Reports, start);
 
     let start = Instant::now();
@@ -179,7 +186,16 @@ pub fn publish(
         peer_comparison::render_markdown(&peer_comparison::arap_against_libigl(&run.results, &run.scenarios));
     html::write_index(
         dir,
-        &html::render_index(&run.results, &run.data_source, &images, &table1, &peers, &outcome, &run.notes),
+        &html::render_index(
+            &run.results,
+            &run.data_source,
+            &run.provenance.summary(),
+            &images,
+            &table1,
+            &peers,
+            &outcome,
+            &run.notes,
+        ),
     )?;
     timed(RunPhase::GateAndIndex, start);
 
@@ -196,7 +212,14 @@ pub fn publish(
 /// Write part `shard` of a run (`run` holds that part's cases): `results.json` and every result
 /// mesh (OFF, full precision), what `harness merge` needs. Returns the number of failed cases.
 pub fn publish_partial(options: &SuiteOptions, run: &SuiteRun, shard: Shard) -> Result<usize, HarnessError> {
-    report::write_partial(&options.reports_dir, &run.results, &run.scenarios, &run.data_source, shard)?;
+    report::write_partial(
+        &options.reports_dir,
+        &run.results,
+        &run.scenarios,
+        &run.data_source,
+        &run.provenance,
+        shard,
+    )?;
     Ok(run.results.iter().filter(|r| r.status.is_failed()).count())
 }
 

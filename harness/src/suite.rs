@@ -9,6 +9,7 @@ use crate::case::{run_case, CaseResult, Reference};
 use crate::config::{MethodCatalog, PeerSetup};
 use crate::error::HarnessError;
 use crate::metrics::RestGeometry;
+use crate::provenance::Provenance;
 use crate::scenario::{load_spec, load_specs, DataSource, LoadedScenario, ScenarioSpec, FILE_SOURCE};
 use crate::shard::{assign, estimated_cost, Shard};
 use crate::verdict::VerdictRules;
@@ -42,6 +43,10 @@ pub struct SuiteOptions {
     /// Add the peer methods of this file (`configs/peers.toml`, `--peers`) to every scenario that
     /// does not restrict its methods.
     pub peers: Option<PeerSetup>,
+    /// Worker threads of every method ([`crate::threads`]).
+    pub threads: usize,
+    /// The command that asked for the run, for its record.
+    pub command_line: Vec<String>,
     pub progress: bool,
 }
 
@@ -52,6 +57,8 @@ pub struct SuiteRun {
     pub data_source: String,
     /// What loading the scenarios noticed (dropped or duplicate vertices), each naming its scenario.
     pub notes: Vec<String>,
+    /// Where and how the run was made.
+    pub provenance: Provenance,
 }
 
 impl SuiteOptions {
@@ -178,15 +185,17 @@ fn plan(options: &SuiteOptions, catalog: &MethodCatalog, scenarios: &[LoadedScen
 /// Run every selected method on every scenario. [`REFERENCE_METHOD`] runs first in each scenario so
 /// the others can be compared with it; results are reported in registry order.
 pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
+    let provenance = Provenance::record(options.command_line.clone(), options.threads);
     let (config, scenarios, source) = prepare(options)?;
     let plan = plan(options, &config.catalog, &scenarios);
-    let results = run_plan(options, &config, &scenarios, &plan);
+    let results = run_plan(options, &config, &scenarios, &plan)?;
     let data_source = describe_data(&source, &scenarios);
-    Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source })
+    Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source, provenance })
 }
 
 /// Run the scenarios of part `shard` of the suite ([`crate::shard::assign`] on their estimated cost).
 pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, HarnessError> {
+    let provenance = Provenance::record(options.command_line.clone(), options.threads);
     let (config, scenarios, source) = prepare(options)?;
     let data_source = describe_data(&source, &scenarios);
     let plan = plan(options, &config.catalog, &scenarios);
@@ -204,8 +213,8 @@ pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, Harne
         .filter(|((_, keep), _)| *keep)
         .unzip();
     let scenarios: Vec<LoadedScenario> = mine.into_iter().map(|(s, _)| s).collect();
-    let results = run_plan(options, &config, &scenarios, &plan);
-    Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source })
+    let results = run_plan(options, &config, &scenarios, &plan)?;
+    Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source, provenance })
 }
 
 /// The notes of every scenario, each named.
@@ -218,6 +227,17 @@ fn notes_of(scenarios: &[LoadedScenario]) -> Vec<String> {
 
 /// Run `plan[i]` (method names) on `scenarios[i]` for every `i`.
 fn run_plan(
+    options: &SuiteOptions,
+    config: &RunConfig,
+    scenarios: &[LoadedScenario],
+    plan: &[Vec<String>],
+) -> Result<Vec<CaseResult>, HarnessError> {
+    let pool = crate::threads::pool(options.threads)?;
+    Ok(pool.install(|| run_cases(options, config, scenarios, plan)))
+}
+
+/// [`run_plan`]'s cases, in the calling thread pool.
+fn run_cases(
     options: &SuiteOptions,
     config: &RunConfig,
     scenarios: &[LoadedScenario],
@@ -254,7 +274,8 @@ fn run_plan(
                     .join("logs")
                     .join(format!("{}-{}.stderr.txt", scenario.spec.name, method.name))
             });
-            let case = run_case(scenario, &rest, method, stderr_log, &config.rules, reference);
+            let case =
+                run_case(scenario, &rest, method, stderr_log, options.threads, &config.rules, reference);
             cases.push(case);
             bar.inc(1);
         }
@@ -270,12 +291,14 @@ fn run_plan(
 /// from its mesh file. Errors: a missing or repeated part, parts of different runs (data source or
 /// N), a case of a scenario the options do not load, a mesh that does not fit its scenario.
 pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, HarnessError> {
+    let mut provenance = Provenance::record(options.command_line.clone(), options.threads);
     let (config, scenarios, source) = prepare(options)?;
     let data_source = describe_data(&source, &scenarios);
+    let mut records: Vec<(usize, Provenance)> = Vec::new();
     let mut parts: Vec<(Shard, PathBuf, Vec<CaseResult>)> = Vec::with_capacity(dirs.len());
     for dir in dirs {
         let path = dir.join("results.json");
-        let crate::report::StoredReport { cases, data_source: their_source, shard } =
+        let crate::report::StoredReport { cases, data_source: their_source, shard, provenance: record } =
             crate::report::read_results(&path)?;
         let config = |message: String| HarnessError::Config { path: path.clone(), message };
         let shard = shard.ok_or_else(|| config("not a partial report (written without --shard)".into()))?;
@@ -287,6 +310,9 @@ pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, Harne
         }
         if let Some((other, _, _)) = parts.iter().find(|(s, _, _)| s.count != shard.count) {
             return Err(config(format!("is part {shard}, but another part is {other}")));
+        }
+        if let Some(record) = record {
+            records.push((shard.index, record));
         }
         parts.push((shard, dir.clone(), cases));
     }
@@ -301,6 +327,8 @@ pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, Harne
             message: format!("the merge lacks part(s) {}", missing.join(", ")),
         });
     }
+    records.sort_by_key(|(index, _)| *index);
+    provenance.parts = records.into_iter().map(|(_, record)| record).collect();
     let plan = plan(options, &config.catalog, &scenarios);
     let mut results: Vec<(usize, usize, CaseResult)> = Vec::new();
     for (_, dir, cases) in parts {
@@ -327,7 +355,7 @@ pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, Harne
     }
     results.sort_by_key(|(i, order, _)| (*i, *order));
     let results: Vec<CaseResult> = results.into_iter().map(|(_, _, c)| c).collect();
-    Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source })
+    Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source, provenance })
 }
 
 /// One line on where the meshes of `scenarios` came from.

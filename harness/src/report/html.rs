@@ -25,12 +25,13 @@ fn number(v: f64, digits: usize) -> String {
     }
 }
 
-/// The page for `results` (with `data_source`), linking `images` (paths relative to the report
+/// The page for `results` (with `data_source` and the run's `provenance` line), linking `images` (paths relative to the report
 /// directory: plots and figures) and showing `table1_markdown` (HIRM's Table 1 as written to
 /// `table1.md`) and `peers` (our ARAP against libigl's, `peers.md`; empty: none).
 pub fn render_index(
     results: &[CaseResult],
     data_source: &str,
+    provenance: &str,
     images: &[PathBuf],
     table1_markdown: &str,
     peers: &str,
@@ -61,6 +62,7 @@ pub fn render_index(
          with the rest mesh:</p>",
         escape(data_source)
     );
+    let _ = writeln!(page, "<p id=\"provenance\">Made by this {}.</p>", escape(provenance));
     page.push_str("<dl class=\"metrics\">\n");
     for spec in &METRICS {
         let unit = if spec.unit.is_empty() { String::new() } else { format!(" ({})", spec.unit) };

@@ -10,6 +10,7 @@ use serde::Serialize;
 use crate::case::CaseResult;
 use crate::error::HarnessError;
 use crate::metrics::METRICS;
+use crate::provenance::Provenance;
 use crate::scenario::LoadedScenario;
 use crate::shard::Shard;
 
@@ -54,6 +55,7 @@ struct JsonReport<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     shard: Option<String>,
     units: &'static str,
+    provenance: &'a Provenance,
     cases: &'a [CaseResult],
 }
 
@@ -63,6 +65,8 @@ pub struct StoredReport {
     pub data_source: String,
     /// The part, for a partial report.
     pub shard: Option<Shard>,
+    /// Where and how it was made (none in a report of an older harness).
+    pub provenance: Option<Provenance>,
 }
 
 /// Read a `results.json` written by a run (or a shard of one).
@@ -72,6 +76,8 @@ pub fn read_results(path: &Path) -> Result<StoredReport, HarnessError> {
         data_source: String,
         #[serde(default)]
         shard: Option<String>,
+        #[serde(default)]
+        provenance: Option<Provenance>,
         cases: Vec<CaseResult>,
     }
     let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
@@ -80,7 +86,12 @@ pub fn read_results(path: &Path) -> Result<StoredReport, HarnessError> {
         .map_err(|e| config(format!("not a results.json of this harness: {e}")))?;
     let shard =
         stored.shard.map(|s| s.parse::<Shard>()).transpose().map_err(|e| config(format!("shard: {e}")))?;
-    Ok(StoredReport { cases: stored.cases, data_source: stored.data_source, shard })
+    Ok(StoredReport {
+        cases: stored.cases,
+        data_source: stored.data_source,
+        shard,
+        provenance: stored.provenance,
+    })
 }
 
 /// A CSV number: empty for NaN (a missing value), else 7 significant digits.
@@ -132,6 +143,7 @@ pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
 pub fn render_json(
     results: &[CaseResult],
     data_source: &str,
+    provenance: &Provenance,
     shard: Option<Shard>,
 ) -> Result<Vec<u8>, HarnessError> {
     let report = JsonReport {
@@ -139,6 +151,7 @@ pub fn render_json(
         data_source,
         shard: shard.map(|s| s.to_string()),
         units: "times in seconds (median_iteration_ms in milliseconds); angles in degrees; *_over_diag relative to the rest bounding-box diagonal; e_area, e_length RMS log ratios; volume_change and folds fractions",
+        provenance,
         cases: results,
     };
     // NaN is not JSON: serde_json writes it as null, which is what a missing value should be.
@@ -314,10 +327,11 @@ pub fn write_reports(
     results: &[CaseResult],
     scenarios: &[LoadedScenario],
     data_source: &str,
+    provenance: &Provenance,
     meshes: &MeshOutput,
 ) -> Result<(), HarnessError> {
     let csv = render_csv(results)?;
-    let json = render_json(results, data_source, None)?;
+    let json = render_json(results, data_source, provenance, None)?;
     write_meshes(dir, results, scenarios, meshes)?;
     write_bytes(&dir.join("convergence.csv"), &render_convergence(results)?)?;
     write_bytes(&dir.join("handle_updates.csv"), &render_handle_updates(results)?)?;
@@ -340,9 +354,10 @@ pub fn write_partial(
     results: &[CaseResult],
     scenarios: &[LoadedScenario],
     data_source: &str,
+    provenance: &Provenance,
     shard: Shard,
 ) -> Result<(), HarnessError> {
-    let json = render_json(results, data_source, Some(shard))?;
+    let json = render_json(results, data_source, provenance, Some(shard))?;
     let every_mesh = MeshOutput { format: MeshFormat::Off, every_scenario: true };
     write_meshes(dir, results, scenarios, &every_mesh)?;
     write_bytes(&dir.join("results.json"), &json)

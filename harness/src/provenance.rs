@@ -1,0 +1,235 @@
+//! Where and how a run was made, written at the top of `results.json` and of the page: the machine
+//! (CPU, logical cores, memory, OS and kernel), the build (crate version, git commit of the workspace
+//! and whether its tree was dirty when the run started, rustc, profile) and the run (start time,
+//! command line, threads, jobs, repetitions). Anything that cannot be read is `unknown`, never an
+//! error: a record is a courtesy to the reader, not a precondition of the run.
+
+use serde::{Deserialize, Serialize};
+
+/// The record of one run.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    pub machine: Machine,
+    pub build: Build,
+    pub run: RunRecord,
+    /// A merge's parts (`all --shard K/N`), each with its own record, in part order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub parts: Vec<Provenance>,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Machine {
+    /// `model name` of /proc/cpuinfo.
+    pub cpu_model: String,
+    pub logical_cores: usize,
+    /// MemTotal of /proc/meminfo, GiB.
+    pub memory_gib: f64,
+    /// PRETTY_NAME of /etc/os-release.
+    pub os: String,
+    pub kernel: String,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Build {
+    /// The harness crate's version.
+    pub version: String,
+    /// `git rev-parse HEAD` of the workspace, when it is a git checkout.
+    pub git_commit: Option<String>,
+    /// Whether tracked files differed from that commit when the run started.
+    pub git_dirty: Option<bool>,
+    pub rustc: String,
+    /// `release` or `debug`.
+    pub profile: String,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RunRecord {
+    /// Start of the run, UTC, `YYYY-MM-DDTHH:MM:SSZ`.
+    pub started_utc: String,
+    pub command_line: Vec<String>,
+    /// Worker threads of every method (`--threads`).
+    pub threads: usize,
+    /// Cases run at a time.
+    pub jobs: usize,
+    /// Repetitions of each case's timed phases.
+    pub repetitions: usize,
+}
+
+const UNKNOWN: &str = "unknown";
+
+impl Provenance {
+    /// The record of a run started now with `command_line` on `threads` worker threads.
+    pub fn record(command_line: Vec<String>, threads: usize) -> Self {
+        Provenance {
+            machine: Machine::read(),
+            build: Build::read(),
+            run: RunRecord {
+                started_utc: utc_timestamp(std::time::SystemTime::now()),
+                command_line,
+                threads,
+                jobs: 1,
+                repetitions: 1,
+            },
+            parts: Vec::new(),
+        }
+    }
+
+    /// One line for the page and the console.
+    pub fn summary(&self) -> String {
+        let m = &self.machine;
+        let b = &self.build;
+        let commit = match (&b.git_commit, b.git_dirty) {
+            (Some(c), Some(true)) => format!("{} (dirty)", &c[..c.len().min(12)]),
+            (Some(c), _) => c[..c.len().min(12)].to_string(),
+            (None, _) => UNKNOWN.to_string(),
+        };
+        let parts = match self.parts.len() {
+            0 => String::new(),
+            n => format!("; merged from {n} parts run on {}", {
+                let mut machines: Vec<&str> =
+                    self.parts.iter().map(|p| p.machine.cpu_model.as_str()).collect();
+                machines.dedup();
+                machines.join(", ")
+            }),
+        };
+        format!(
+            "run {} on {} ({} logical cores, {:.0} GiB, {}, kernel {}); harness {} at {commit}, {}, {} profile; {} thread(s), {} job(s), {} repetition(s){parts}",
+            self.run.started_utc,
+            m.cpu_model,
+            m.logical_cores,
+            m.memory_gib,
+            m.os,
+            m.kernel,
+            b.version,
+            b.rustc,
+            b.profile,
+            self.run.threads,
+            self.run.jobs,
+            self.run.repetitions
+        )
+    }
+}
+
+impl Machine {
+    fn read() -> Self {
+        let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+        let cpu_model = field(&cpuinfo, "model name", ':').unwrap_or_else(|| UNKNOWN.into());
+        let meminfo = std::fs::read_to_string("/proc/meminfo").unwrap_or_default();
+        let memory_kib: f64 = field(&meminfo, "MemTotal", ':')
+            .and_then(|v| v.split_whitespace().next().and_then(|n| n.parse().ok()))
+            .unwrap_or(f64::NAN);
+        let os_release = std::fs::read_to_string("/etc/os-release").unwrap_or_default();
+        let os = field(&os_release, "PRETTY_NAME", '=')
+            .map(|v| v.trim_matches('"').to_string())
+            .unwrap_or_else(|| std::env::consts::OS.to_string());
+        let kernel = std::fs::read_to_string("/proc/sys/kernel/osrelease")
+            .map(|s| s.trim().to_string())
+            .unwrap_or_else(|_| UNKNOWN.into());
+        Machine {
+            cpu_model,
+            logical_cores: crate::threads::default_threads(),
+            memory_gib: memory_kib / (1024.0 * 1024.0),
+            os,
+            kernel,
+        }
+    }
+}
+
+impl Build {
+    fn read() -> Self {
+        let root = crate::suite::workspace_root();
+        let git = |args: &[&str]| {
+            std::process::Command::new("git")
+                .arg("-C")
+                .arg(&root)
+                .args(args)
+                .output()
+                .ok()
+                .filter(|o| o.status.success())
+                .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        };
+        let git_commit = git(&["rev-parse", "HEAD"]);
+        let git_dirty = git_commit
+            .as_ref()
+            .and_then(|_| git(&["status", "--porcelain", "--untracked-files=no"]))
+            .map(|status| !status.is_empty());
+        Build {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            git_commit,
+            git_dirty,
+            rustc: env!("DEFORMBENCH_RUSTC_VERSION").to_string(),
+            profile: env!("DEFORMBENCH_PROFILE").to_string(),
+        }
+    }
+}
+
+/// The value of the first line `key<sep> value` of `text`, trimmed.
+fn field(text: &str, key: &str, separator: char) -> Option<String> {
+    text.lines().find_map(|line| {
+        let (k, v) = line.split_once(separator)?;
+        (k.trim() == key).then(|| v.trim().to_string())
+    })
+}
+
+/// `time` as `YYYY-MM-DDTHH:MM:SSZ` (UTC; civil date from days since 1970, Howard Hinnant's
+/// algorithm).
+pub fn utc_timestamp(time: std::time::SystemTime) -> String {
+    let seconds = time.duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs()) as i64;
+    let (days, of_day) = (seconds.div_euclid(86_400), seconds.rem_euclid(86_400));
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        of_day / 3600,
+        of_day % 3600 / 60,
+        of_day % 60
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::{Duration, UNIX_EPOCH};
+
+    #[test]
+    fn timestamps_are_civil_utc() {
+        assert_eq!(utc_timestamp(UNIX_EPOCH), "1970-01-01T00:00:00Z");
+        // 2000-02-29 12:34:56 UTC, a leap day.
+        assert_eq!(utc_timestamp(UNIX_EPOCH + Duration::from_secs(951_827_696)), "2000-02-29T12:34:56Z");
+        assert_eq!(utc_timestamp(UNIX_EPOCH + Duration::from_secs(1_796_256_000)), "2026-12-03T00:00:00Z");
+    }
+
+    #[test]
+    fn the_record_of_this_machine_is_sane() {
+        let p = Provenance::record(vec!["harness".into(), "all".into()], 3);
+        assert!(p.machine.logical_cores >= 1);
+        assert!(p.machine.memory_gib > 0.1 && p.machine.memory_gib < 1e5, "{}", p.machine.memory_gib);
+        assert!(!p.machine.cpu_model.is_empty() && !p.machine.kernel.is_empty());
+        assert!(p.build.rustc.starts_with("rustc "), "{}", p.build.rustc);
+        assert!(["release", "debug"].contains(&p.build.profile.as_str()), "{}", p.build.profile);
+        if let Some(commit) = &p.build.git_commit {
+            assert!(commit.len() == 40 && commit.chars().all(|c| c.is_ascii_hexdigit()), "{commit}");
+        }
+        assert_eq!((p.run.threads, p.run.jobs, p.run.repetitions), (3, 1, 1));
+        assert!(p.run.started_utc.starts_with("20") && p.run.started_utc.ends_with('Z'));
+        let line = p.summary();
+        assert!(line.contains("3 thread(s)") && line.contains(&p.machine.kernel), "{line}");
+    }
+
+    #[test]
+    fn fields_are_read_by_key() {
+        assert_eq!(field("a : 1\nmodel name\t: Xeon\n", "model name", ':').as_deref(), Some("Xeon"));
+        assert_eq!(
+            field("NAME=x\nPRETTY_NAME=\"Debian\"\n", "PRETTY_NAME", '=').as_deref(),
+            Some("\"Debian\"")
+        );
+        assert_eq!(field("", "x", ':'), None);
+    }
+}
