@@ -685,7 +685,11 @@ fn shards_merged_equal_one_run_to_the_last_digit() {
     // The merge keeps each part's record, in part order.
     let parts = merged["provenance"]["parts"].as_array().expect("the parts' records");
     assert_eq!(parts.len(), 3);
-    assert!(parts.iter().all(|p| p["run"]["command_line"].as_array().unwrap().iter().any(|a| a == "--shard")));
+    assert!(parts.iter().all(|p| p["run"]["command_line"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|a| a == "--shard")));
     assert!(whole["provenance"].get("parts").is_none());
     let (a, b) = (whole["cases"].as_array().unwrap(), merged["cases"].as_array().unwrap());
     assert_eq!(a.len(), 9);

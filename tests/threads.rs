@@ -76,6 +76,16 @@ fn threads_during_run(count: &str) -> BTreeSet<(u64, String)> {
     assert_eq!(record["run"]["command_line"][1], "run");
     assert!(record["machine"]["logical_cores"].as_u64().unwrap() >= 1);
     assert!(record["build"]["rustc"].as_str().unwrap().starts_with("rustc "));
+    let inputs: Vec<String> = record["inputs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .inspect(|i| assert_eq!(i["sha256"].as_str().unwrap().len(), 64))
+        .map(|i| i["path"].as_str().unwrap().to_string())
+        .collect();
+    for file in ["methods.toml", "verdicts.toml", "scenarios/bar.toml"] {
+        assert!(inputs.iter().any(|p| p.ends_with(file)), "{file} not in {inputs:?}");
+    }
     let page = std::fs::read_to_string(reports.join("index.html")).unwrap();
     assert!(page.contains(&format!("{count} thread(s)")), "the page states the threads");
     let seen = seen.join().unwrap();

@@ -12,6 +12,9 @@ pub struct Provenance {
     pub machine: Machine,
     pub build: Build,
     pub run: RunRecord,
+    /// Every mesh, selection, transform and config file the run read, with its SHA-256.
+    #[serde(default)]
+    pub inputs: Vec<InputFile>,
     /// A merge's parts (`all --shard K/N`), each with its own record, in part order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub parts: Vec<Provenance>,
@@ -70,6 +73,7 @@ impl Provenance {
                 jobs: 1,
                 repetitions: 1,
             },
+            inputs: Vec::new(),
             parts: Vec::new(),
         }
     }
@@ -163,6 +167,34 @@ impl Build {
     }
 }
 
+/// One input file and its SHA-256 (hex).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct InputFile {
+    pub path: String,
+    pub sha256: String,
+}
+
+/// The SHA-256 of every file of `paths` that exists (once each, in order; a glob pattern or a
+/// directory is skipped).
+pub fn hash_inputs(paths: impl IntoIterator<Item = std::path::PathBuf>) -> Vec<InputFile> {
+    use sha2::Digest;
+    let mut out: Vec<InputFile> = Vec::new();
+    for path in paths {
+        let name = path.display().to_string();
+        if !path.is_file() || out.iter().any(|f| f.path == name) {
+            continue;
+        }
+        let Ok(mut file) = std::fs::File::open(&path) else { continue };
+        let mut hasher = sha2::Sha256::new();
+        if std::io::copy(&mut file, &mut hasher).is_err() {
+            continue;
+        }
+        let digest = hasher.finalize();
+        out.push(InputFile { path: name, sha256: digest.iter().map(|b| format!("{b:02x}")).collect() });
+    }
+    out
+}
+
 /// The value of the first line `key<sep> value` of `text`, trimmed.
 fn field(text: &str, key: &str, separator: char) -> Option<String> {
     text.lines().find_map(|line| {
@@ -221,6 +253,18 @@ mod tests {
         assert!(p.run.started_utc.starts_with("20") && p.run.started_utc.ends_with('Z'));
         let line = p.summary();
         assert!(line.contains("3 thread(s)") && line.contains(&p.machine.kernel), "{line}");
+    }
+
+    #[test]
+    fn inputs_are_hashed_once_and_missing_ones_skipped() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("abc.txt");
+        std::fs::write(&file, "abc").unwrap();
+        let inputs =
+            hash_inputs([file.clone(), dir.path().join("*.off"), file.clone(), dir.path().to_path_buf()]);
+        assert_eq!(inputs.len(), 1);
+        // FIPS 180-2's test vector.
+        assert_eq!(inputs[0].sha256, "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
     }
 
     #[test]

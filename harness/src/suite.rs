@@ -185,8 +185,9 @@ fn plan(options: &SuiteOptions, catalog: &MethodCatalog, scenarios: &[LoadedScen
 /// Run every selected method on every scenario. [`REFERENCE_METHOD`] runs first in each scenario so
 /// the others can be compared with it; results are reported in registry order.
 pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
-    let provenance = Provenance::record(options.command_line.clone(), options.threads);
+    let mut provenance = Provenance::record(options.command_line.clone(), options.threads);
     let (config, scenarios, source) = prepare(options)?;
+    provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let plan = plan(options, &config.catalog, &scenarios);
     let results = run_plan(options, &config, &scenarios, &plan)?;
     let data_source = describe_data(&source, &scenarios);
@@ -195,8 +196,9 @@ pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
 
 /// Run the scenarios of part `shard` of the suite ([`crate::shard::assign`] on their estimated cost).
 pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, HarnessError> {
-    let provenance = Provenance::record(options.command_line.clone(), options.threads);
+    let mut provenance = Provenance::record(options.command_line.clone(), options.threads);
     let (config, scenarios, source) = prepare(options)?;
+    provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let data_source = describe_data(&source, &scenarios);
     let plan = plan(options, &config.catalog, &scenarios);
     let costs: Vec<f64> = scenarios
@@ -215,6 +217,18 @@ pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, Harne
     let scenarios: Vec<LoadedScenario> = mine.into_iter().map(|(s, _)| s).collect();
     let results = run_plan(options, &config, &scenarios, &plan)?;
     Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source, provenance })
+}
+
+/// Every file the run read: the configuration, each scenario file and what it named.
+fn inputs_of(options: &SuiteOptions, scenarios: &[LoadedScenario]) -> Vec<PathBuf> {
+    let mut paths: Vec<PathBuf> =
+        ["methods.toml", "verdicts.toml"].iter().map(|f| options.configs_dir.join(f)).collect();
+    paths.extend(options.peers.as_ref().map(|p| p.file.clone()));
+    for s in scenarios {
+        paths.push(s.spec.path.clone());
+        paths.extend(s.spec.files_read.paths());
+    }
+    paths
 }
 
 /// The notes of every scenario, each named.
@@ -293,6 +307,7 @@ fn run_cases(
 pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, HarnessError> {
     let mut provenance = Provenance::record(options.command_line.clone(), options.threads);
     let (config, scenarios, source) = prepare(options)?;
+    provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let data_source = describe_data(&source, &scenarios);
     let mut records: Vec<(usize, Provenance)> = Vec::new();
     let mut parts: Vec<(Shard, PathBuf, Vec<CaseResult>)> = Vec::with_capacity(dirs.len());

@@ -57,7 +57,7 @@ use serde::Deserialize;
 
 use crate::error::HarnessError;
 pub use motion::{Motion, RotateSpec, TransformSpec, Units};
-pub use selection::{InputIndex, PathContext, Role, Selection, SelectionFiles};
+pub use selection::{FilesRead, InputIndex, PathContext, Role, Selection, SelectionFiles};
 
 /// The `mesh_source` of a scenario whose mesh was read from a file named in the scenario.
 pub const FILE_SOURCE: &str = "file";
@@ -102,6 +102,9 @@ pub struct ScenarioSpec {
     /// The file it was read from.
     #[serde(skip)]
     pub path: PathBuf,
+    /// Every file the scenario named and loading read (meshes, selections, transforms).
+    #[serde(skip)]
+    pub files_read: FilesRead,
 }
 
 /// A region as written: its vertices and, for a handle, its transform (see [`motion`]). The
@@ -373,7 +376,7 @@ impl ScenarioSpec {
     /// Where this scenario's relative paths start.
     fn paths(&self, stem: Option<String>) -> PathContext {
         let base = self.path.parent().map(Path::to_path_buf).unwrap_or_default();
-        PathContext { base, stem }
+        PathContext { base, stem, read: self.files_read.clone() }
     }
 
     /// Load the mesh(es) and edit and validate them: one scenario, or one per file of a collection
@@ -395,6 +398,7 @@ impl ScenarioSpec {
             return paths
                 .iter()
                 .map(|p| {
+                    self.files_read.push(p.clone());
                     let stem = file_stem(p);
                     self.load_file(p, &format!("{}-{stem}", self.name), Some(stem))
                 })
@@ -418,6 +422,9 @@ impl ScenarioSpec {
         ) {
             (DataSource::Survey(dir), Some(stem), _) => {
                 let mesh_path = dir.join(format!("{stem}.off"));
+                for extension in ["off", "sel", "def"] {
+                    self.files_read.push(dir.join(format!("{stem}.{extension}")));
+                }
                 let mesh = meshes::io::read_mesh(&mesh_path)?;
                 mesh.check_nondegenerate().map_err(|e| e.in_file(&mesh_path))?;
                 let topology = Topology::new(&mesh).map_err(|e| e.in_file(&mesh_path))?;

@@ -167,7 +167,7 @@ mod tests {
     }
 
     fn paths() -> PathContext {
-        PathContext { base: ".".into(), stem: None }
+        PathContext { base: ".".into(), stem: None, read: Default::default() }
     }
 
     fn apply(m: &Motion, p: [f64; 3]) -> [f64; 3] {

@@ -81,6 +81,27 @@ pub struct PathContext {
     pub base: PathBuf,
     /// The mesh file's stem, for `{stem}` (collections).
     pub stem: Option<String>,
+    /// Every path resolved, for the run's record of its inputs.
+    pub read: FilesRead,
+}
+
+/// The files a scenario named, shared by its clones (the run provenance hashes them).
+#[derive(Clone, Debug, Default)]
+pub struct FilesRead(std::sync::Arc<std::sync::Mutex<Vec<PathBuf>>>);
+
+impl FilesRead {
+    pub fn push(&self, path: PathBuf) {
+        if let Ok(mut paths) = self.0.lock() {
+            if !paths.contains(&path) {
+                paths.push(path);
+            }
+        }
+    }
+
+    /// The paths so far, in the order they were first named.
+    pub fn paths(&self) -> Vec<PathBuf> {
+        self.0.lock().map(|p| p.clone()).unwrap_or_default()
+    }
 }
 
 impl PathContext {
@@ -95,7 +116,9 @@ impl PathContext {
         }
         let text = crate::variables::expand(&text, "the directory it names")?;
         let p = PathBuf::from(text);
-        Ok(if p.is_absolute() { p } else { self.base.join(p) })
+        let resolved = if p.is_absolute() { p } else { self.base.join(p) };
+        self.read.push(resolved.clone());
+        Ok(resolved)
     }
 }
 
@@ -284,7 +307,7 @@ mod tests {
         s.vertices(
             &line(),
             input,
-            &PathContext { base: "/data".into(), stem: Some("knight".into()) },
+            &PathContext { base: "/data".into(), stem: Some("knight".into()), read: FilesRead::default() },
             &NoFiles,
         )
     }
@@ -322,7 +345,11 @@ mod tests {
 
     #[test]
     fn paths_resolve_against_the_scenario_with_variables_and_stems() {
-        let ctx = PathContext { base: "/configs/real".into(), stem: Some("knight".into()) };
+        let ctx = PathContext {
+            base: "/configs/real".into(),
+            stem: Some("knight".into()),
+            read: FilesRead::default(),
+        };
         assert_eq!(
             ctx.resolve("{stem}-selection.dmat").unwrap(),
             PathBuf::from("/configs/real/knight-selection.dmat")
@@ -335,7 +362,7 @@ mod tests {
         );
         let e = ctx.resolve("${DEFORMBENCH_TEST_UNSET_VARIABLE}/a.off").unwrap_err();
         assert!(e.contains("DEFORMBENCH_TEST_UNSET_VARIABLE"), "{e}");
-        let no_stem = PathContext { base: ".".into(), stem: None };
+        let no_stem = PathContext { base: ".".into(), stem: None, read: FilesRead::default() };
         assert!(no_stem.resolve("{stem}.sel").unwrap_err().contains("needs a mesh file"));
     }
 }
