@@ -243,6 +243,14 @@ fn peers_run_beside_arap_and_land_near_it() {
     assert_eq!(libigl["converged"], "true");
     // Linear: a twist it cannot follow without rotations.
     assert!(num(row(&rows, "libigl_biharmonic"), "e_theta_deg") > num(row(&rows, "arap"), "e_theta_deg"));
+    // The provenance names what each peer said it is.
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(reports.join("results.json")).unwrap()).unwrap();
+    let external = json["provenance"]["external"].as_array().unwrap();
+    assert_eq!(external.len(), 4, "{external:?}");
+    assert!(external
+        .iter()
+        .any(|e| e["method"] == "libigl_arap" && e["about"].as_str().unwrap().contains("libigl 2.6.3")));
     let peers = std::fs::read_to_string(reports.join("peers.md")).unwrap();
     assert!(peers.contains("| bar | "), "{peers}");
     let page = std::fs::read_to_string(reports.join("index.html")).unwrap();

@@ -15,6 +15,9 @@ pub struct Provenance {
     /// Every mesh, selection, transform and config file the run read, with its SHA-256.
     #[serde(default)]
     pub inputs: Vec<InputFile>,
+    /// What each external method said it is (its `about`: interpreter, library and version).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub external: Vec<ExternalRecord>,
     /// A merge's parts (`all --shard K/N`), each with its own record, in part order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub parts: Vec<Provenance>,
@@ -74,6 +77,7 @@ impl Provenance {
                 repetitions: 1,
             },
             inputs: Vec::new(),
+            external: Vec::new(),
             parts: Vec::new(),
         }
     }
@@ -165,6 +169,26 @@ impl Build {
             profile: env!("DEFORMBENCH_PROFILE").to_string(),
         }
     }
+}
+
+/// An external method and its own account of itself.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ExternalRecord {
+    pub method: String,
+    pub about: String,
+}
+
+/// The `about` of every external method of `results`, once per method.
+pub fn external_records(results: &[crate::case::CaseResult]) -> Vec<ExternalRecord> {
+    let mut out: Vec<ExternalRecord> = Vec::new();
+    for r in results.iter().filter(|r| r.origin != crate::config::Origin::BuiltIn) {
+        if let Some(about) = &r.about {
+            if !out.iter().any(|e| e.method == r.method) {
+                out.push(ExternalRecord { method: r.method.clone(), about: about.clone() });
+            }
+        }
+    }
+    out
 }
 
 /// One input file and its SHA-256 (hex).

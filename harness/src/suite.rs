@@ -190,6 +190,7 @@ pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let plan = plan(options, &config.catalog, &scenarios);
     let results = run_plan(options, &config, &scenarios, &plan)?;
+    provenance.external = crate::provenance::external_records(&results);
     let data_source = describe_data(&source, &scenarios);
     Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source, provenance })
 }
@@ -216,6 +217,7 @@ pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, Harne
         .unzip();
     let scenarios: Vec<LoadedScenario> = mine.into_iter().map(|(s, _)| s).collect();
     let results = run_plan(options, &config, &scenarios, &plan)?;
+    provenance.external = crate::provenance::external_records(&results);
     Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source, provenance })
 }
 
