@@ -197,10 +197,10 @@ pub enum Reference<'a> {
     Missing,
 }
 
-/// Run `method` (a fresh instance; an external method's stderr goes to `stderr_log`, and its thread
-/// variables say `threads`) on
-/// `scenario`, measure the result against `rest` (the scenario's rest geometry) and `reference`,
-/// and judge it by `rules`. A method error becomes a `failed` result; it does not abort the run.
+/// Run `method` on `scenario` (a fresh instance; an external method's stderr goes to `stderr_log`
+/// and its thread variables say `threads`), measure the result against `rest` (the scenario's rest
+/// geometry) and `reference`, and judge it by `rules`. A method error becomes a `failed` result; it
+/// does not abort the run.
 pub fn run_case(
     scenario: &LoadedScenario,
     rest: &RestGeometry,
