@@ -278,3 +278,57 @@ fn peers_run_beside_arap_and_land_near_it() {
     let page = std::fs::read_to_string(reports.join("index.html")).unwrap();
     assert!(page.contains("peers not run: the Python /nonexistent/python does not exist"));
 }
+
+#[test]
+fn repetitions_give_a_spread_and_catch_a_non_deterministic_method() {
+    let dir = tempfile::tempdir().unwrap();
+    let toy = support::workspace_root().join("tests/external/toy_method.py");
+    let toys = format!(
+        "[toy_random]\ncommand = [\"python3\", \"{toy}\", \"random\"]\n\n[toy_ok]\ncommand = [\"python3\", \"{toy}\", \"ok\"]\n",
+        toy = toy.display()
+    );
+    let bar = "name = \"bar\"\nprocedural = { shape = \"bar\", vertices = 800 }\n\
+               methods = [\"laplacian\", \"isolines\", \"toy_random\", \"toy_ok\"]\n"
+        .to_string();
+    let configs = configs_in(dir.path(), &[("bar.toml", bar)], &toys);
+    let reports = dir.path().join("reports");
+    let args = [
+        "run",
+        "--repeat",
+        "3",
+        "--scenario",
+        "bar",
+        "--quiet",
+        "--configs",
+        configs.to_str().unwrap(),
+        "--reports",
+        reports.to_str().unwrap(),
+        "--method",
+        "laplacian",
+        "--method",
+        "isolines",
+        "--method",
+        "toy_random",
+        "--method",
+        "toy_ok",
+    ];
+    assert_eq!(run(&args).unwrap(), ExitCode::SUCCESS);
+    let rows = csv_rows(&reports.join("results.csv"));
+    for method in ["laplacian", "isolines", "toy_ok"] {
+        let r = row(&rows, method);
+        assert!(!r["status"].contains("non-deterministic"), "{method}: {}", r["status"]);
+        assert_eq!(r["repetitions"], "3");
+        for phase in ["precompute_s", "bind_s", "solve_s", "total_s"] {
+            let (min, median, max) =
+                (num(r, &format!("{phase}_min")), num(r, phase), num(r, &format!("{phase}_max")));
+            assert!(min <= median && median <= max, "{method} {phase}: {min} {median} {max}");
+        }
+    }
+    let random = &row(&rows, "toy_random")["status"];
+    assert!(random.contains("non-deterministic: repetition 2's result differs from the first"), "{random}");
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(reports.join("results.json")).unwrap()).unwrap();
+    assert_eq!(json["provenance"]["run"]["repetitions"], 3);
+    let page = std::fs::read_to_string(reports.join("index.html")).unwrap();
+    assert!(page.contains("min–max over 3 repetitions"));
+}

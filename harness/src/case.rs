@@ -135,8 +135,77 @@ pub struct CaseResult {
     /// What measuring this case cost the harness (excluded from the timings above).
     #[serde(default)]
     pub overhead: MeasurementTime,
+    /// The spread of the timings over the repetitions (`--repeat`); the top-level `precompute_s`,
+    /// `bind_s`, `solve_s` and `total_s` are their medians. The steps, the trace and every measure
+    /// are the first repetition's.
+    #[serde(default)]
+    pub spread: Option<TimingSpread>,
     #[serde(skip)]
     pub positions: Option<Vec<[f64; 3]>>,
+}
+
+/// The smallest and largest of a timing over the repetitions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Spread {
+    #[serde(deserialize_with = "nan_from_null")]
+    pub min: f64,
+    #[serde(deserialize_with = "nan_from_null")]
+    pub max: f64,
+}
+
+/// Every timed phase of a case over its repetitions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TimingSpread {
+    pub repetitions: usize,
+    pub precompute_s: Spread,
+    /// The first step's bind.
+    pub bind_s: Spread,
+    pub solve_s: Spread,
+    pub total_s: Spread,
+}
+
+/// The timed phases of one repetition of a case.
+#[derive(Clone, Copy, Debug)]
+struct Timings {
+    precompute_s: f64,
+    bind_s: f64,
+    solve_s: f64,
+    total_s: f64,
+}
+
+/// Median, min and max of `values` (not empty).
+fn median_spread(mut values: Vec<f64>) -> (f64, Spread) {
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    let median = if n % 2 == 1 { values[n / 2] } else { 0.5 * (values[n / 2 - 1] + values[n / 2]) };
+    (median, Spread { min: values[0], max: values[n - 1] })
+}
+
+/// One more repetition of `method` on `scenario`: a fresh instance through every edit step, no
+/// observer; its timings and final `#V x 3` positions.
+fn repetition(
+    scenario: &LoadedScenario,
+    method: &ConfiguredMethod,
+    threads: usize,
+) -> Result<(Timings, Vec<[f64; 3]>), methods::MethodError> {
+    let mut m = method.create(None, threads)?;
+    let start = Instant::now();
+    m.precompute(&scenario.mesh)?;
+    let precompute_s = start.elapsed().as_secs_f64();
+    let (mut first_bind_s, mut solve_s) = (f64::NAN, 0.0);
+    for step in &scenario.steps {
+        let targets = step.targets(&m.positions())?;
+        let t = Instant::now();
+        m.bind_handles(&step.handles)?;
+        if first_bind_s.is_nan() {
+            first_bind_s = t.elapsed().as_secs_f64();
+        }
+        let t = Instant::now();
+        m.solve(&targets, &mut methods::NoObserver)?;
+        solve_s += t.elapsed().as_secs_f64();
+    }
+    let total_s = start.elapsed().as_secs_f64();
+    Ok((Timings { precompute_s, bind_s: first_bind_s, solve_s, total_s }, m.positions()))
 }
 
 /// Wall seconds the harness spent measuring one case, kept out of the method's timings.
@@ -207,6 +276,7 @@ pub fn run_case(
     method: &ConfiguredMethod,
     stderr_log: Option<std::path::PathBuf>,
     threads: usize,
+    repetitions: usize,
     rules: &VerdictRules,
     reference: Reference<'_>,
 ) -> CaseResult {
@@ -318,11 +388,72 @@ pub fn run_case(
     result.median_iteration_ms = median_ms(&recorder.trace);
     result.trace = recorder.trace;
     result.overhead.trace_quality_s = recorder.quality_s;
+    let outcome = outcome.map(|mut reasons| {
+        reasons.extend(repeat(&mut result, scenario, rest, method, threads, repetitions));
+        reasons
+    });
     result.status = match outcome {
         Ok(reasons) => Status::judge(&unfinished, reasons),
         Err(e) => Status::Failed(e.to_string()),
     };
     result
+}
+
+/// Repetitions 2..=`repetitions` of a case whose first one is `result`: the timings become medians
+/// with their spread; a repetition whose result is not bitwise the first's, or that fails, gives a
+/// `non-deterministic` reason.
+fn repeat(
+    result: &mut CaseResult,
+    scenario: &LoadedScenario,
+    rest: &RestGeometry,
+    method: &ConfiguredMethod,
+    threads: usize,
+    repetitions: usize,
+) -> Vec<String> {
+    let first = Timings {
+        precompute_s: result.precompute_s,
+        bind_s: result.bind_s,
+        solve_s: result.solve_s,
+        total_s: result.total_s,
+    };
+    let mut timings = vec![first];
+    let mut reasons = Vec::new();
+    for k in 2..=repetitions.max(1) {
+        match repetition(scenario, method, threads) {
+            Ok((t, positions)) => {
+                timings.push(t);
+                let reference = result.positions.as_deref().unwrap_or_default();
+                let same = positions.len() == reference.len()
+                    && positions
+                        .iter()
+                        .flatten()
+                        .zip(reference.iter().flatten())
+                        .all(|(a, b)| a.to_bits() == b.to_bits());
+                if !same && !reasons.iter().any(|r: &String| r.starts_with("non-deterministic")) {
+                    let apart = largest_displacement(reference, &positions) / rest.diagonal;
+                    reasons.push(format!(
+                        "non-deterministic: repetition {k}'s result differs from the first (up to {apart:.1e} of the diagonal)"
+                    ));
+                }
+            }
+            Err(e) => reasons.push(format!("non-deterministic: repetition {k} failed: {e}")),
+        }
+    }
+    let spread = |f: fn(&Timings) -> f64| median_spread(timings.iter().map(f).collect());
+    let (precompute_s, precompute) = spread(|t| t.precompute_s);
+    let (bind_s, bind) = spread(|t| t.bind_s);
+    let (solve_s, solve) = spread(|t| t.solve_s);
+    let (total_s, total) = spread(|t| t.total_s);
+    (result.precompute_s, result.bind_s, result.solve_s, result.total_s) =
+        (precompute_s, bind_s, solve_s, total_s);
+    result.spread = Some(TimingSpread {
+        repetitions: timings.len(),
+        precompute_s: precompute,
+        bind_s: bind,
+        solve_s: solve,
+        total_s: total,
+    });
+    reasons
 }
 
 fn nan() -> f64 {
@@ -372,6 +503,7 @@ impl CaseResult {
             steps: Vec::new(),
             trace: Vec::new(),
             overhead: MeasurementTime::default(),
+            spread: None,
             positions: None,
         }
     }
@@ -392,6 +524,13 @@ fn median_ms(trace: &[IterationRecord]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_median_of_an_even_count_is_the_mean_of_the_middle_two() {
+        assert_eq!(median_spread(vec![3.0, 1.0, 2.0]), (2.0, Spread { min: 1.0, max: 3.0 }));
+        assert_eq!(median_spread(vec![4.0, 1.0, 2.0, 3.0]), (2.5, Spread { min: 1.0, max: 4.0 }));
+        assert_eq!(median_spread(vec![5.0]), (5.0, Spread { min: 5.0, max: 5.0 }));
+    }
 
     #[test]
     fn quality_is_recorded_densely_then_on_a_geometric_grid() {

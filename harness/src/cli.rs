@@ -180,6 +180,12 @@ struct Common {
     /// [default: every logical core]. `--threads 1` is like for like with single-threaded peers.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     threads: Option<u32>,
+    /// Time each case N times, each with a fresh method instance (a fresh process for an external
+    /// method): timing columns give the median with min and max; the measures come from the first
+    /// repetition, and a later result that is not bitwise the first makes the case `suspect:
+    /// non-deterministic`.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    repeat: u32,
 }
 
 #[derive(Args, Clone)]
@@ -212,6 +218,7 @@ impl Common {
             peers: None,
             threads: self.threads.map_or_else(crate::threads::default_threads, |t| t as usize),
             command_line: command_line.to_vec(),
+            repetitions: self.repeat as usize,
             progress: !self.quiet,
         }
     }

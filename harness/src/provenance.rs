@@ -64,8 +64,9 @@ pub struct RunRecord {
 const UNKNOWN: &str = "unknown";
 
 impl Provenance {
-    /// The record of a run started now with `command_line` on `threads` worker threads.
-    pub fn record(command_line: Vec<String>, threads: usize) -> Self {
+    /// The record of a run started now with `command_line` on `threads` worker threads, each case
+    /// timed `repetitions` times.
+    pub fn record(command_line: Vec<String>, threads: usize, repetitions: usize) -> Self {
         Provenance {
             machine: Machine::read(),
             build: Build::read(),
@@ -74,7 +75,7 @@ impl Provenance {
                 command_line,
                 threads,
                 jobs: 1,
-                repetitions: 1,
+                repetitions,
             },
             inputs: Vec::new(),
             external: Vec::new(),
@@ -264,7 +265,7 @@ mod tests {
 
     #[test]
     fn the_record_of_this_machine_is_sane() {
-        let p = Provenance::record(vec!["harness".into(), "all".into()], 3);
+        let p = Provenance::record(vec!["harness".into(), "all".into()], 3, 1);
         assert!(p.machine.logical_cores >= 1);
         assert!(p.machine.memory_gib > 0.1 && p.machine.memory_gib < 1e5, "{}", p.machine.memory_gib);
         assert!(!p.machine.cpu_model.is_empty() && !p.machine.kernel.is_empty());

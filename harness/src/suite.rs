@@ -45,6 +45,8 @@ pub struct SuiteOptions {
     pub peers: Option<PeerSetup>,
     /// Worker threads of every method ([`crate::threads`]).
     pub threads: usize,
+    /// Repetitions of each case's timed phases (`--repeat`).
+    pub repetitions: usize,
     /// The command that asked for the run, for its record.
     pub command_line: Vec<String>,
     pub progress: bool,
@@ -185,7 +187,8 @@ fn plan(options: &SuiteOptions, catalog: &MethodCatalog, scenarios: &[LoadedScen
 /// Run every selected method on every scenario. [`REFERENCE_METHOD`] runs first in each scenario so
 /// the others can be compared with it; results are reported in registry order.
 pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
-    let mut provenance = Provenance::record(options.command_line.clone(), options.threads);
+    let mut provenance =
+        Provenance::record(options.command_line.clone(), options.threads, options.repetitions);
     let (config, scenarios, source) = prepare(options)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let plan = plan(options, &config.catalog, &scenarios);
@@ -197,7 +200,8 @@ pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
 
 /// Run the scenarios of part `shard` of the suite ([`crate::shard::assign`] on their estimated cost).
 pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, HarnessError> {
-    let mut provenance = Provenance::record(options.command_line.clone(), options.threads);
+    let mut provenance =
+        Provenance::record(options.command_line.clone(), options.threads, options.repetitions);
     let (config, scenarios, source) = prepare(options)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let data_source = describe_data(&source, &scenarios);
@@ -290,8 +294,16 @@ fn run_cases(
                     .join("logs")
                     .join(format!("{}-{}.stderr.txt", scenario.spec.name, method.name))
             });
-            let case =
-                run_case(scenario, &rest, method, stderr_log, options.threads, &config.rules, reference);
+            let case = run_case(
+                scenario,
+                &rest,
+                method,
+                stderr_log,
+                options.threads,
+                options.repetitions,
+                &config.rules,
+                reference,
+            );
             cases.push(case);
             bar.inc(1);
         }
@@ -307,7 +319,8 @@ fn run_cases(
 /// from its mesh file. Errors: a missing or repeated part, parts of different runs (data source or
 /// N), a case of a scenario the options do not load, a mesh that does not fit its scenario.
 pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, HarnessError> {
-    let mut provenance = Provenance::record(options.command_line.clone(), options.threads);
+    let mut provenance =
+        Provenance::record(options.command_line.clone(), options.threads, options.repetitions);
     let (config, scenarios, source) = prepare(options)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let data_source = describe_data(&source, &scenarios);

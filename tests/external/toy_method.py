@@ -14,6 +14,7 @@ at the request it names:
   hang             starts a grandchild (`sleep 600`, its pid written to PID_FILE) and never answers `solve`
   ignore-stdin     starts a grandchild likewise and never reads its input again
   exit-at-start    exits with status 7 before reading anything
+  random           well-behaved but for one free vertex moved by a random amount (non-deterministic)
 """
 
 import json
@@ -73,6 +74,11 @@ for line in sys.stdin:
             print("Traceback (most recent call last):\n  ZeroDivisionError: toy division by zero", file=sys.stderr)
             sys.stderr.flush()
             sys.exit(3)
+        if mode == "random":
+            import random
+
+            free = next(v for v in range(len(positions)) if v not in set(message["constrained"]))
+            positions[free] = [c + random.random() * 1e-9 for c in positions[free]]
         if mode == "wrong-count":
             positions = positions[:-1]
         if mode == "nan":

@@ -151,10 +151,10 @@ pub fn render_index(
             r.iterations,
             if r.converged { "yes" } else { "no" },
             number(r.startup_s, 3),
-            number(r.precompute_s, 3),
-            number(r.bind_s, 4),
-            number(r.solve_s, 3),
-            number(r.total_s, 3),
+            timing(r.precompute_s, r.spread.map(|s| (s.repetitions, s.precompute_s)), 3),
+            timing(r.bind_s, r.spread.map(|s| (s.repetitions, s.bind_s)), 4),
+            timing(r.solve_s, r.spread.map(|s| (s.repetitions, s.solve_s)), 3),
+            timing(r.total_s, r.spread.map(|s| (s.repetitions, s.total_s)), 3),
             number(r.median_iteration_ms, 3),
         );
         for spec in &METRICS {
@@ -232,6 +232,19 @@ pub fn render_index(
         "</script>\n</body>\n</html>\n"
     ));
     page
+}
+
+/// A timing cell: the value, and below it the min–max range when it is a median of repetitions.
+fn timing(value: f64, spread: Option<(usize, crate::case::Spread)>, digits: usize) -> String {
+    match spread {
+        Some((n, s)) if n > 1 => format!(
+            "{}<br><small title=\"min–max over {n} repetitions\">{}–{}</small>",
+            number(value, digits),
+            number(s.min, digits),
+            number(s.max, digits)
+        ),
+        _ => number(value, digits),
+    }
 }
 
 /// A path relative to the report directory as a URL path (forward slashes).

@@ -324,7 +324,11 @@ fn draw_timings<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &
         let bind: f64 = c.steps.iter().map(|s| s.bind_s).sum();
         [c.precompute_s, bind, c.solve_s].map(|v| if v.is_finite() { v } else { 0.0 })
     };
-    let top = cases.iter().map(|c| parts(c).iter().sum::<f64>()).fold(0.0, f64::max).max(1e-3) * 1.12;
+    let highest = |c: &&CaseResult| {
+        let whisker = c.spread.map_or(0.0, |s| s.total_s.max).max(0.0);
+        parts(c).iter().sum::<f64>().max(if whisker.is_finite() { whisker } else { 0.0 })
+    };
+    let top = cases.iter().map(highest).fold(0.0, f64::max).max(1e-3) * 1.12;
     let n = cases.len().max(1);
     let title = format!("{scenario}: time per phase (seconds)");
     let mut chart = category_chart(&root, &title, "seconds", cases, top)?;
@@ -340,6 +344,18 @@ fn draw_timings<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &
                 )))
                 .map_err(err)?;
             bottom += value;
+        }
+        // The spread of the total over the repetitions, as a whisker.
+        if let Some(spread) = c.spread.filter(|s| s.repetitions > 1 && s.total_s.max.is_finite()) {
+            let (x, lo, hi) = (i as f64 + 0.5, spread.total_s.min, spread.total_s.max);
+            let whisker = [(x, lo), (x, hi)];
+            let caps = [[(x - 0.1, lo), (x + 0.1, lo)], [(x - 0.1, hi), (x + 0.1, hi)]];
+            chart
+                .draw_series(std::iter::once(PathElement::new(whisker, BLACK.stroke_width(2))))
+                .map_err(err)?;
+            chart
+                .draw_series(caps.into_iter().map(|c| PathElement::new(c, BLACK.stroke_width(2))))
+                .map_err(err)?;
         }
         chart
             .draw_series(std::iter::once(Text::new(

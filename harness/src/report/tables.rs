@@ -31,6 +31,15 @@ const CASE_COLUMNS: &[&str] = &[
     "solve_s",
     "total_s",
     "converged",
+    "repetitions",
+    "precompute_s_min",
+    "precompute_s_max",
+    "bind_s_min",
+    "bind_s_max",
+    "solve_s_min",
+    "solve_s_max",
+    "total_s_min",
+    "total_s_max",
 ];
 
 /// The CSV columns after the metrics.
@@ -126,6 +135,12 @@ pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
             num(r.total_s),
             r.converged.to_string(),
         ];
+        let spread = r.spread.unwrap_or_default();
+        row.push(spread.repetitions.to_string());
+        for s in [spread.precompute_s, spread.bind_s, spread.solve_s, spread.total_s] {
+            let (min, max) = if r.spread.is_some() { (s.min, s.max) } else { (f64::NAN, f64::NAN) };
+            row.extend([num(min), num(max)]);
+        }
         row.extend(METRICS.iter().map(|s| r.quality.get(s.metric).map(num).unwrap_or_default()));
         row.extend([
             num(r.largest_move_over_diag),
