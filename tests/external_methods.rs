@@ -119,9 +119,17 @@ fn processes_with(needle: &str) -> Vec<u32> {
 fn timeless(case: &serde_json::Value) -> serde_json::Value {
     let mut c = case.clone();
     let object = c.as_object_mut().unwrap();
-    for key in
-        ["precompute_s", "bind_s", "median_iteration_ms", "solve_s", "total_s", "phase_timings", "overhead"]
-    {
+    for key in [
+        "precompute_s",
+        "bind_s",
+        "median_iteration_ms",
+        "solve_s",
+        "total_s",
+        "phase_timings",
+        "overhead",
+        "spread",
+        "startup_s",
+    ] {
         object.remove(key);
     }
     for step in object["steps"].as_array_mut().unwrap() {

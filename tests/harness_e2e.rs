@@ -582,9 +582,17 @@ fn missing_survey_directory_is_rejected() {
 fn timeless(case: &serde_json::Value) -> serde_json::Value {
     let mut c = case.clone();
     let object = c.as_object_mut().unwrap();
-    for key in
-        ["precompute_s", "bind_s", "median_iteration_ms", "solve_s", "total_s", "phase_timings", "overhead"]
-    {
+    for key in [
+        "precompute_s",
+        "bind_s",
+        "median_iteration_ms",
+        "solve_s",
+        "total_s",
+        "phase_timings",
+        "overhead",
+        "spread",
+        "startup_s",
+    ] {
         object.remove(key);
     }
     for step in object.get_mut("steps").unwrap().as_array_mut().unwrap() {
