@@ -15,21 +15,8 @@ fn run(args: &[&str]) -> anyhow::Result<ExitCode> {
     harness::cli::run(full)
 }
 
-fn csv_rows(path: &Path) -> Vec<HashMap<String, String>> {
-    let mut reader = csv::Reader::from_path(path).unwrap();
-    let headers = reader.headers().unwrap().clone();
-    reader
-        .records()
-        .map(|r| headers.iter().map(String::from).zip(r.unwrap().iter().map(String::from)).collect())
-        .collect()
-}
-
 fn row<'a>(rows: &'a [HashMap<String, String>], method: &str) -> &'a HashMap<String, String> {
     rows.iter().find(|r| r["method"] == method).unwrap_or_else(|| panic!("no row of {method}"))
-}
-
-fn num(row: &HashMap<String, String>, key: &str) -> f64 {
-    row[key].parse().unwrap_or_else(|_| panic!("{key} = {:?} is not a number", row[key]))
 }
 
 /// A copy of the committed configs (methods, verdicts, peers) in `dir/configs`, its scenarios
@@ -83,15 +70,19 @@ fn the_readme_example_method_runs_as_written() {
     full.extend(["--quiet", "--configs", configs.to_str().unwrap(), "--reports", reports.to_str().unwrap()]);
     assert_eq!(run(&full).unwrap(), ExitCode::SUCCESS, "{command}");
 
-    let rows = csv_rows(&reports.join("results.csv"));
+    let rows = support::csv_rows(&reports.join("results.csv"));
     let example = row(&rows, "harmonic_displacement");
     assert_eq!(example["origin"], "external");
     assert!(!example["status"].starts_with("failed"), "{}", example["status"]);
-    assert!(num(example, "startup_s") > 0.0);
+    assert!(support::num(example, "startup_s") > 0.0);
     // A direct method that puts every handle on its target, exactly as the pipe carries it.
-    assert!(num(example, "handle_residual_over_diag") < 1e-12, "{}", example["handle_residual_over_diag"]);
     assert!(
-        num(example, "e_theta_deg") > num(row(&rows, "arap"), "e_theta_deg"),
+        support::num(example, "handle_residual_over_diag") < 1e-12,
+        "{}",
+        example["handle_residual_over_diag"]
+    );
+    assert!(
+        support::num(example, "e_theta_deg") > support::num(row(&rows, "arap"), "e_theta_deg"),
         "no rotations: worse than arap"
     );
     assert_eq!(row(&rows, "arap")["origin"], "built-in");
@@ -113,34 +104,6 @@ fn processes_with(needle: &str) -> Vec<u32> {
         }
     }
     pids
-}
-
-/// The fields of a results.json case that do not depend on timing.
-fn timeless(case: &serde_json::Value) -> serde_json::Value {
-    let mut c = case.clone();
-    let object = c.as_object_mut().unwrap();
-    for key in [
-        "precompute_s",
-        "bind_s",
-        "median_iteration_ms",
-        "solve_s",
-        "total_s",
-        "phase_timings",
-        "overhead",
-        "spread",
-        "startup_s",
-    ] {
-        object.remove(key);
-    }
-    for step in object["steps"].as_array_mut().unwrap() {
-        for key in ["bind_s", "solve_s", "median_iteration_ms", "phase_timings"] {
-            step.as_object_mut().unwrap().remove(key);
-        }
-    }
-    for record in object["trace"].as_array_mut().unwrap() {
-        record.as_object_mut().unwrap().remove("seconds");
-    }
-    c
 }
 
 #[test]
@@ -180,7 +143,7 @@ fn a_broken_method_beside_built_in_ones_fails_alone_and_leaves_nothing_running()
     let (code, plain_reports) = all(&plain, "plain-reports");
     assert_eq!(code, ExitCode::SUCCESS);
 
-    let rows = csv_rows(&broken_reports.join("results.csv"));
+    let rows = support::csv_rows(&broken_reports.join("results.csv"));
     let status = |m: &str| row(&rows, m)["status"].clone();
     for (method, needles) in [
         (
@@ -202,7 +165,13 @@ fn a_broken_method_beside_built_in_ones_fails_alone_and_leaves_nothing_running()
     let cases = |reports: &Path| -> Vec<serde_json::Value> {
         let json: serde_json::Value =
             serde_json::from_slice(&std::fs::read(reports.join("results.json")).unwrap()).unwrap();
-        json["cases"].as_array().unwrap().iter().filter(|c| c["origin"] == "built-in").map(timeless).collect()
+        json["cases"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|c| c["origin"] == "built-in")
+            .map(support::timeless)
+            .collect()
     };
     let (with, without) = (cases(&broken_reports), cases(&plain_reports));
     assert_eq!(with.len(), 3);
@@ -238,7 +207,7 @@ fn peers_run_beside_arap_and_land_near_it() {
     }
     args.extend(["--configs", configs.to_str().unwrap(), "--reports", reports.to_str().unwrap()]);
     assert_eq!(run(&args).unwrap(), ExitCode::SUCCESS);
-    let rows = csv_rows(&reports.join("results.csv"));
+    let rows = support::csv_rows(&reports.join("results.csv"));
     assert_eq!(rows.len(), 5);
     for r in rows.iter().filter(|r| r["method"] != "arap") {
         assert_eq!(r["origin"], "peer", "{}", r["method"]);
@@ -247,10 +216,13 @@ fn peers_run_beside_arap_and_land_near_it() {
     // The same energy to the same tolerance: the same shape, up to the weights (ours are the
     // intrinsic Delaunay cotangents) and libigl's single-precision rotation fit.
     let libigl = row(&rows, "libigl_arap");
-    assert!(num(libigl, "rms_to_arap_over_diag") < 1e-3, "{}", libigl["rms_to_arap_over_diag"]);
+    assert!(support::num(libigl, "rms_to_arap_over_diag") < 1e-3, "{}", libigl["rms_to_arap_over_diag"]);
     assert_eq!(libigl["converged"], "true");
     // Linear: a twist it cannot follow without rotations.
-    assert!(num(row(&rows, "libigl_biharmonic"), "e_theta_deg") > num(row(&rows, "arap"), "e_theta_deg"));
+    assert!(
+        support::num(row(&rows, "libigl_biharmonic"), "e_theta_deg")
+            > support::num(row(&rows, "arap"), "e_theta_deg")
+    );
     // The provenance names what each peer said it is.
     let json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(reports.join("results.json")).unwrap()).unwrap();
@@ -282,7 +254,7 @@ fn peers_run_beside_arap_and_land_near_it() {
         reports.to_str().unwrap(),
     ];
     assert_eq!(run(&args).unwrap(), ExitCode::SUCCESS);
-    assert_eq!(csv_rows(&reports.join("results.csv")).len(), 1);
+    assert_eq!(support::csv_rows(&reports.join("results.csv")).len(), 1);
     let page = std::fs::read_to_string(reports.join("index.html")).unwrap();
     assert!(page.contains("peers not run: the Python /nonexistent/python does not exist"));
 }
@@ -321,14 +293,17 @@ fn repetitions_give_a_spread_and_catch_a_non_deterministic_method() {
         "toy_ok",
     ];
     assert_eq!(run(&args).unwrap(), ExitCode::SUCCESS);
-    let rows = csv_rows(&reports.join("results.csv"));
+    let rows = support::csv_rows(&reports.join("results.csv"));
     for method in ["laplacian", "isolines", "toy_ok"] {
         let r = row(&rows, method);
         assert!(!r["status"].contains("non-deterministic"), "{method}: {}", r["status"]);
         assert_eq!(r["repetitions"], "3");
         for phase in ["precompute_s", "bind_s", "solve_s", "total_s"] {
-            let (min, median, max) =
-                (num(r, &format!("{phase}_min")), num(r, phase), num(r, &format!("{phase}_max")));
+            let (min, median, max) = (
+                support::num(r, &format!("{phase}_min")),
+                support::num(r, phase),
+                support::num(r, &format!("{phase}_max")),
+            );
             assert!(min <= median && median <= max, "{method} {phase}: {min} {median} {max}");
         }
     }

@@ -14,19 +14,6 @@ fn run(args: &[&str]) -> anyhow::Result<std::process::ExitCode> {
     harness::cli::run(full)
 }
 
-fn csv_rows(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
-    let mut reader = csv::Reader::from_path(path).unwrap();
-    let headers = reader.headers().unwrap().clone();
-    reader
-        .records()
-        .map(|r| headers.iter().map(String::from).zip(r.unwrap().iter().map(String::from)).collect())
-        .collect()
-}
-
-fn num(row: &std::collections::HashMap<String, String>, key: &str) -> f64 {
-    row[key].parse().unwrap_or_else(|_| panic!("{key} = {:?} is not a number", row[key]))
-}
-
 #[test]
 fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
     let Some(survey) = support::survey_dir() else { return };
@@ -41,7 +28,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
     ])
     .unwrap();
     assert_eq!(code, std::process::ExitCode::SUCCESS);
-    let rows = csv_rows(&reports.path().join("results.csv"));
+    let rows = support::csv_rows(&reports.path().join("results.csv"));
     // Issue 18: lean outputs. The resolution sweeps write no meshes unless asked (`--every-mesh`),
     // and the whole report stays under 50 MB.
     assert!(rows.iter().any(|r| r["scenario"] == "bar-sweep-200k"));
@@ -64,7 +51,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
                 row["laplacian_weights"], "intrinsic_delaunay",
                 "{scenario}/{method}: the default is reported"
             );
-            let residual = num(row, "handle_residual_over_diag");
+            let residual = support::num(row, "handle_residual_over_diag");
             // The issue's bounds for the references; the reduced models only approximate their handles.
             let bound = match method {
                 "arap" => 1e-9,
@@ -85,7 +72,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
                 "rms_to_arap_over_diag",
                 "max_to_arap_over_diag",
             ] {
-                let v = num(row, key);
+                let v = support::num(row, key);
                 assert!(v.is_finite() && v >= 0.0, "{scenario}/{method}: {key} = {v}");
             }
             // GLB by default; OFF only with `--mesh-format off|both`.
@@ -96,7 +83,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
             assert!(!reports.path().join(format!("meshes/{scenario}-{method}.off")).exists());
         }
         let arap = rows.iter().find(|r| r["scenario"] == scenario && r["method"] == "arap").unwrap();
-        assert_eq!(num(arap, "rms_to_arap_over_diag"), 0.0);
+        assert_eq!(support::num(arap, "rms_to_arap_over_diag"), 0.0);
         // The isoline model reaches its hard handles, does not fold and stays in its frame.
         let isolines = rows.iter().find(|r| r["scenario"] == scenario && r["method"] == "isolines").unwrap();
         assert_eq!(isolines["status"], "ok", "{scenario}/isolines");
@@ -107,13 +94,16 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
         rows.iter().find(|r| r["scenario"] == scenario && r["method"] == method).unwrap()
     };
     assert!(case("bar", "arap")["volume_change"].is_empty(), "the survey bar is open");
-    let (balloon, arap) = (num(case("bar", "scale_aware"), "e_area"), num(case("bar", "arap"), "e_area"));
+    let (balloon, arap) =
+        (support::num(case("bar", "scale_aware"), "e_area"), support::num(case("bar", "arap"), "e_area"));
     assert!(balloon > 0.4 && balloon > 5.0 * arap, "bar e_area: scale_aware {balloon}, arap {arap}");
     // The closed cylinder: the linear-ish methods and scale_aware shrink it, arap far less.
-    let arap_volume = num(case("cylinder", "arap"), "volume_change");
+    let arap_volume = support::num(case("cylinder", "arap"), "volume_change");
     for method in ["laplacian", "isolines", "scale_aware"] {
-        let (area, volume) =
-            (num(case("cylinder", method), "e_area"), num(case("cylinder", method), "volume_change"));
+        let (area, volume) = (
+            support::num(case("cylinder", method), "e_area"),
+            support::num(case("cylinder", method), "volume_change"),
+        );
         assert!(
             area > 0.3 && volume < -0.2 && volume < 2.0 * arap_volume,
             "cylinder/{method}: e_area {area}, volume {volume}"
@@ -124,8 +114,8 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
     // isoline model's E_theta (issue 16).
     let (hirm, isolines) = (case("cactus-handles", "hirm"), case("cactus-handles", "isolines"));
     assert_eq!(hirm["status"], "ok", "cactus-handles/hirm");
-    assert_eq!(num(hirm, "folds"), 0.0);
-    let ratio = num(hirm, "e_theta_deg") / num(isolines, "e_theta_deg");
+    assert_eq!(support::num(hirm, "folds"), 0.0);
+    let ratio = support::num(hirm, "e_theta_deg") / support::num(isolines, "e_theta_deg");
     assert!(ratio <= 1.5, "cactus-handles: hirm E_theta {ratio:.2}x that of isolines");
     // hirm converges on every survey test (the 200K-vertex sweep bar aside).
     for scenario in
@@ -139,7 +129,8 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
     // the arap reference: with the intrinsic Delaunay weights the reference moved and 20 isolines are
     // 1.2% farther from it (RMS 0.0453 vs 0.0447 of the diagonal; with cotan weights 20 were nearer).
     let bar = |method: &str| rows.iter().find(|r| r["scenario"] == "bar" && r["method"] == method).unwrap();
-    let (fine, coarse) = (num(bar("isolines"), "e_phi_deg"), num(bar("isolines_10"), "e_phi_deg"));
+    let (fine, coarse) =
+        (support::num(bar("isolines"), "e_phi_deg"), support::num(bar("isolines_10"), "e_phi_deg"));
     assert!(fine <= coarse, "bar: e_phi_deg with 20 isolines {fine} > with 10 {coarse}");
     // The standard suite ends with the regression gate (the exit code above says it passed) and
     // a page with every plot and figure.
@@ -162,7 +153,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
 
     // Per-iteration angle errors (the scale-aware paper's Fig. 6): Algorithm 1 ends well below its
     // Laplacian initialization (iteration 0) on the cactus.
-    let convergence = csv_rows(&reports.path().join("convergence.csv"));
+    let convergence = support::csv_rows(&reports.path().join("convergence.csv"));
     for method in ["scale_aware", "scale_aware_ora"] {
         let rows: Vec<_> =
             convergence.iter().filter(|r| r["scenario"] == "cactus" && r["method"] == method).collect();
@@ -172,7 +163,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
         assert!(curve.len() < rows.len(), "cactus/{method}: {} iterations, all evaluated", rows.len());
         assert!(curve.iter().all(|r| !r["e_phi_deg"].is_empty()));
         for key in ["e_theta_deg", "e_phi_deg"] {
-            let (first, last) = (num(curve[0], key), num(curve[curve.len() - 1], key));
+            let (first, last) = (support::num(curve[0], key), support::num(curve[curve.len() - 1], key));
             assert!(
                 last < 0.5 * first,
                 "cactus/{method}: {key} {first} at the initialization, {last} at the end"
@@ -181,7 +172,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
     }
 
     // Incremental editing (HIRM section 4.5): every method runs both steps; the second adds a handle.
-    let updates = csv_rows(&reports.path().join("handle_updates.csv"));
+    let updates = support::csv_rows(&reports.path().join("handle_updates.csv"));
     for scenario in ["bar-incremental", "cactus-incremental"] {
         for method in methods::registry::method_names() {
             let row = rows.iter().find(|r| r["scenario"] == scenario && r["method"] == method).unwrap();
@@ -190,7 +181,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
                 updates.iter().filter(|u| u["scenario"] == scenario && u["method"] == method).collect();
             let handles: Vec<&str> = steps.iter().map(|u| u["handles"].as_str()).collect();
             assert_eq!(handles, ["2", "3"], "{scenario}/{method}");
-            assert!(steps.iter().all(|u| num(u, "bind_ms") >= 0.0));
+            assert!(steps.iter().all(|u| support::num(u, "bind_ms") >= 0.0));
         }
     }
     // HIRM's Table 1: 2, 6 and 10 handles on the bar and the cactus, with the field count.
@@ -201,7 +192,10 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
                 .iter()
                 .find(|u| u["scenario"] == scenario && u["method"] == "hirm" && u["handles"] == n_h);
             let row = row.unwrap_or_else(|| panic!("{scenario}: no hirm step with {n_h} handles"));
-            assert!(num(row, "t_h_ms") > 0.0 && num(row, "t_h_ms") <= num(row, "bind_ms"));
+            assert!(
+                support::num(row, "t_h_ms") > 0.0
+                    && support::num(row, "t_h_ms") <= support::num(row, "bind_ms")
+            );
         }
         assert_eq!(
             table1.lines().filter(|l| l.starts_with(&format!("| {scenario} |"))).count(),
@@ -261,7 +255,7 @@ fn without_survey_data_the_procedural_look_alikes_run_and_are_labelled() {
     }
     let code = run(&args).unwrap();
     assert_eq!(code, std::process::ExitCode::SUCCESS);
-    let rows = csv_rows(&reports.path().join("results.csv"));
+    let rows = support::csv_rows(&reports.path().join("results.csv"));
     assert_eq!(rows.len(), 4 * methods::registry::METHODS.len());
     for row in &rows {
         assert_eq!(row["mesh_source"], "procedural look-alike");
@@ -578,35 +572,6 @@ fn missing_survey_directory_is_rejected() {
     f.expect_error(&["tiny.off"]);
 }
 
-/// The fields of a `results.json` case that do not depend on timing: everything but the times.
-fn timeless(case: &serde_json::Value) -> serde_json::Value {
-    let mut c = case.clone();
-    let object = c.as_object_mut().unwrap();
-    for key in [
-        "precompute_s",
-        "bind_s",
-        "median_iteration_ms",
-        "solve_s",
-        "total_s",
-        "phase_timings",
-        "overhead",
-        "spread",
-        "startup_s",
-    ] {
-        object.remove(key);
-    }
-    for step in object.get_mut("steps").unwrap().as_array_mut().unwrap() {
-        let step = step.as_object_mut().unwrap();
-        for key in ["bind_s", "solve_s", "median_iteration_ms", "phase_timings"] {
-            step.remove(key);
-        }
-    }
-    for record in object.get_mut("trace").unwrap().as_array_mut().unwrap() {
-        record.as_object_mut().unwrap().remove("seconds");
-    }
-    c
-}
-
 /// `harness all --quiet` with the configs directory `configs`, writing to `reports`.
 fn all_with(configs: &Path, reports: &Path) -> anyhow::Result<std::process::ExitCode> {
     run(&["all", "--quiet", "--configs", configs.to_str().unwrap(), "--reports", reports.to_str().unwrap()])
@@ -703,7 +668,7 @@ fn shards_merged_equal_one_run_to_the_last_digit() {
     assert_eq!(a.len(), 9);
     assert_eq!(a.len(), b.len());
     for (x, y) in a.iter().zip(b) {
-        assert_eq!(timeless(x), timeless(y), "{} / {}", x["scenario"], x["method"]);
+        assert_eq!(support::timeless(x), support::timeless(y), "{} / {}", x["scenario"], x["method"]);
     }
     // The same verdict, from the same baseline, and every picture.
     for report in ["whole", "merged"] {
@@ -757,7 +722,7 @@ fn the_same_mesh_in_off_ply_and_glb_gives_the_same_results() {
             .iter()
             .filter(|c| c["scenario"] == format!("bar-{ext}"))
             .map(|c| {
-                let mut c = timeless(c);
+                let mut c = support::timeless(c);
                 c.as_object_mut().unwrap().remove("scenario");
                 c
             })
@@ -916,7 +881,7 @@ fn the_real_mesh_suite_runs_from_toml_alone() {
         reports.path().to_str().unwrap(),
     ];
     assert_eq!(run(&args).unwrap(), std::process::ExitCode::SUCCESS);
-    let rows = csv_rows(&reports.path().join("results.csv"));
+    let rows = support::csv_rows(&reports.path().join("results.csv"));
     assert_eq!(rows.len(), 4 * methods::registry::METHODS.len());
     for (scenario, vertices) in [("knight", 502), ("max", 5272), ("bunny", 3485), ("armadillo", 43243)] {
         for row in rows.iter().filter(|r| r["scenario"] == scenario) {
@@ -926,7 +891,7 @@ fn the_real_mesh_suite_runs_from_toml_alone() {
         }
     }
     // libigl's knight selection: region 0 held, 1 and 2 moved (three regions, 73 vertices).
-    let updates = csv_rows(&reports.path().join("handle_updates.csv"));
+    let updates = support::csv_rows(&reports.path().join("handle_updates.csv"));
     let knight = updates.iter().find(|u| u["scenario"] == "knight" && u["method"] == "arap").unwrap();
     assert_eq!((knight["handles"].as_str(), knight["constrained_vertices"].as_str()), ("3", "73"));
     let result = meshes::io::read_mesh(reports.path().join("meshes/max-isolines.glb")).unwrap();
@@ -955,7 +920,7 @@ fn a_collection_runs_one_scenario_per_matching_mesh() {
     let configs = configs_with(&[("bars.toml".to_string(), text)]);
     let reports = root.path().join("reports");
     assert_eq!(all_with(configs.path(), &reports).unwrap(), std::process::ExitCode::SUCCESS);
-    let rows = csv_rows(&reports.join("results.csv"));
+    let rows = support::csv_rows(&reports.join("results.csv"));
     let names: Vec<(&str, &str)> =
         rows.iter().map(|r| (r["scenario"].as_str(), r["vertices"].as_str())).collect();
     let sizes: Vec<usize> = ["a-small", "b-large"]
@@ -1048,7 +1013,7 @@ fn a_case_stopped_at_its_cap_is_unfinished_and_the_gate_sees_it() {
     let first_run =
         run(&["all", "--quiet", "--configs", config_dir, "--reports", &first, "--no-check"]).unwrap();
     assert_eq!(first_run, std::process::ExitCode::SUCCESS);
-    assert!(csv_rows(&work.path().join("first/results.csv")).iter().all(|r| r["status"] == "ok"));
+    assert!(support::csv_rows(&work.path().join("first/results.csv")).iter().all(|r| r["status"] == "ok"));
     assert_eq!(
         run(&["baseline", "--reports", &first, "--baseline", &baseline]).unwrap(),
         std::process::ExitCode::SUCCESS
@@ -1064,7 +1029,7 @@ fn a_case_stopped_at_its_cap_is_unfinished_and_the_gate_sees_it() {
     std::fs::write(&methods_toml, capped).unwrap();
     let second = dir("second");
     assert_eq!(all(&second), std::process::ExitCode::from(harness::cli::EXIT_REGRESSION));
-    let rows = csv_rows(&work.path().join("second/results.csv"));
+    let rows = support::csv_rows(&work.path().join("second/results.csv"));
     let status = |method: &str| rows.iter().find(|r| r["method"] == method).unwrap()["status"].clone();
     assert_eq!(status("arap"), "ok");
     let laplacian = status("laplacian");

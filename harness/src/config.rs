@@ -1,6 +1,6 @@
 //! The methods of a run, as configured: `configs/methods.toml` holds a table per method, either the
-//! parameters of a built-in method (missing keys take the papers' defaults) or an external program
-//! (`command`, see [`ExternalEntry`]); `configs/peers.toml`, in the same format, holds the peer
+//! parameters of a built-in method (missing keys take the papers' defaults), a variant of one
+//! (`method` and its `params`), or an external program (`command`, see [`ExternalEntry`]); `configs/peers.toml`, in the same format, holds the peer
 //! libraries' adapters that `--peers` adds. Unknown names and keys are errors that name the file.
 
 use std::path::{Path, PathBuf};

@@ -156,12 +156,15 @@ pub fn publish(
 
     let dir = &options.reports_dir;
     let start = Instant::now();
+    let peers =
+        peer_comparison::render_markdown(&peer_comparison::arap_against_libigl(&run.results, &run.scenarios));
     report::write_reports(
         dir,
         &run.results,
         &run.scenarios,
         &run.data_source,
         &run.provenance,
+        &peers,
         &publish.meshes,
     )?;
     timed(RunPhase::Reports, start);
@@ -182,8 +185,6 @@ pub fn publish(
         GateRequest::Skip(reason) => GateOutcome::NotChecked(reason),
     };
     let table1 = report::render_table1(&run.results);
-    let peers =
-        peer_comparison::render_markdown(&peer_comparison::arap_against_libigl(&run.results, &run.scenarios));
     html::write_index(
         dir,
         &html::render_index(

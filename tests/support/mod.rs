@@ -105,3 +105,47 @@ pub fn directory_bytes(dir: &Path) -> u64 {
         })
         .sum()
 }
+
+/// The rows of a `results.csv` as column -> value maps.
+pub fn csv_rows(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let headers = reader.headers().unwrap().clone();
+    reader
+        .records()
+        .map(|r| headers.iter().map(String::from).zip(r.unwrap().iter().map(String::from)).collect())
+        .collect()
+}
+
+/// Column `key` of a CSV row as a number (panics naming it otherwise).
+pub fn num(row: &std::collections::HashMap<String, String>, key: &str) -> f64 {
+    row[key].parse().unwrap_or_else(|_| panic!("{key} = {:?} is not a number", row[key]))
+}
+
+/// The fields of a `results.json` case that do not depend on timing: everything but the times.
+pub fn timeless(case: &serde_json::Value) -> serde_json::Value {
+    let mut c = case.clone();
+    let object = c.as_object_mut().unwrap();
+    for key in [
+        "precompute_s",
+        "bind_s",
+        "median_iteration_ms",
+        "solve_s",
+        "total_s",
+        "phase_timings",
+        "overhead",
+        "spread",
+        "startup_s",
+    ] {
+        object.remove(key);
+    }
+    for step in object.get_mut("steps").unwrap().as_array_mut().unwrap() {
+        let step = step.as_object_mut().unwrap();
+        for key in ["bind_s", "solve_s", "median_iteration_ms", "phase_timings"] {
+            step.remove(key);
+        }
+    }
+    for record in object.get_mut("trace").unwrap().as_array_mut().unwrap() {
+        record.as_object_mut().unwrap().remove("seconds");
+    }
+    c
+}

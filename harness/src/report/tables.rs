@@ -335,7 +335,7 @@ pub struct MeshOutput {
 }
 
 /// Write `results.csv`, `results.json`, `convergence.csv`, `handle_updates.csv`, `table1.md`,
-/// `peers.md` (our `arap` against libigl's, when both ran) and
+/// `peers.md` (`peers`: our ARAP against libigl's, [`super::peer_comparison`]; none when empty) and
 /// the result meshes `meshes/<scenario>-<method>.{glb,off}` that `meshes` asks for under `dir`.
 pub fn write_reports(
     dir: &Path,
@@ -343,6 +343,7 @@ pub fn write_reports(
     scenarios: &[LoadedScenario],
     data_source: &str,
     provenance: &Provenance,
+    peers: &str,
     meshes: &MeshOutput,
 ) -> Result<(), HarnessError> {
     let csv = render_csv(results)?;
@@ -351,9 +352,6 @@ pub fn write_reports(
     write_bytes(&dir.join("convergence.csv"), &render_convergence(results)?)?;
     write_bytes(&dir.join("handle_updates.csv"), &render_handle_updates(results)?)?;
     write_bytes(&dir.join("table1.md"), render_table1(results).as_bytes())?;
-    let peers = super::peer_comparison::render_markdown(&super::peer_comparison::arap_against_libigl(
-        results, scenarios,
-    ));
     if !peers.is_empty() {
         write_bytes(&dir.join("peers.md"), peers.as_bytes())?;
     }
