@@ -688,6 +688,46 @@ fn shards_merged_equal_one_run_to_the_last_digit() {
     assert!(!work.path().join("bad").exists(), "a failed merge writes nothing");
 }
 
+#[test]
+fn jobs_run_cases_at_once_and_report_what_one_job_does() {
+    // Two scenarios with the reference and two others each: with 2 jobs, a scenario's other cases
+    // wait for (or run) its reference, and the report comes back in plan order.
+    let scenarios: Vec<(String, String)> = [("bar", 1800), ("cactus", 1200)]
+        .iter()
+        .map(|(shape, n)| {
+            (
+                format!("{shape}.toml"),
+                format!(
+                    "name = \"{shape}\"\nprocedural = {{ shape = \"{shape}\", vertices = {n} }}\n\
+                     methods = [\"laplacian\", \"arap\", \"isolines\"]\n"
+                ),
+            )
+        })
+        .collect();
+    let configs = configs_with(&scenarios);
+    let configs = configs.path().to_str().unwrap();
+    let work = tempfile::tempdir().unwrap();
+    let dir = |name: &str| work.path().join(name).to_str().unwrap().to_string();
+    let ok = std::process::ExitCode::SUCCESS;
+    for (name, jobs) in [("one", "1"), ("two", "2")] {
+        let args = ["all", "--quiet", "--no-check", "--threads", "1", "--jobs", jobs, "--configs", configs];
+        assert_eq!(run(&[&args[..], &["--reports", &dir(name)]].concat()).unwrap(), ok, "--jobs {jobs}");
+    }
+    let one = read_json(&work.path().join("one/results.json"));
+    let two = read_json(&work.path().join("two/results.json"));
+    assert_eq!(two["provenance"]["run"]["jobs"], 2);
+    assert_eq!(two["provenance"]["run"]["threads"], 1);
+    let (a, b) = (one["cases"].as_array().unwrap(), two["cases"].as_array().unwrap());
+    assert_eq!(a.len(), 6);
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(b) {
+        assert_eq!(support::timeless(x), support::timeless(y), "{} / {}", x["scenario"], x["method"]);
+        assert!(x["rms_to_arap_over_diag"].is_number(), "compared with the reference");
+    }
+    let page = std::fs::read_to_string(work.path().join("two/index.html")).unwrap();
+    assert!(page.contains("1 thread(s), 2 job(s)"), "the page says how the cases ran");
+}
+
 /// The procedural bar written to `dir` as GLB, then the mesh read back from it written as OFF and
 /// binary PLY, so all three files hold the same numbers (GLB stores f32 positions).
 fn bar_in_three_formats(dir: &Path) {

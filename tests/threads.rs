@@ -21,7 +21,7 @@ fn live_threads() -> BTreeSet<(u64, String)> {
 
 /// The threads that ran beside the test's own during `harness run --threads <threads>` (spectral_mhb
 /// and arap on a small bar: faer's Krylov-Schur and arap's parallel local step).
-fn threads_during_run(count: &str) -> BTreeSet<(u64, String)> {
+fn threads_during_run(count: &str, jobs: &str) -> BTreeSet<(u64, String)> {
     let before = live_threads();
     let done = Arc::new(AtomicBool::new(false));
     let seen = {
@@ -54,6 +54,8 @@ fn threads_during_run(count: &str) -> BTreeSet<(u64, String)> {
         "--quiet",
         "--threads",
         count,
+        "--jobs",
+        jobs,
         "--method",
         "spectral_mhb",
         "--method",
@@ -73,6 +75,7 @@ fn threads_during_run(count: &str) -> BTreeSet<(u64, String)> {
         serde_json::from_slice(&std::fs::read(reports.join("results.json")).unwrap()).unwrap();
     let record = &json["provenance"];
     assert_eq!(record["run"]["threads"].as_u64(), Some(count.parse().unwrap()));
+    assert_eq!(record["run"]["jobs"].as_u64(), Some(jobs.parse().unwrap()));
     assert_eq!(record["run"]["command_line"][1], "run");
     assert!(record["machine"]["logical_cores"].as_u64().unwrap() >= 1);
     assert!(record["build"]["rustc"].as_str().unwrap().starts_with("rustc "));
@@ -95,7 +98,9 @@ fn threads_during_run(count: &str) -> BTreeSet<(u64, String)> {
     let mut by_tid = std::collections::BTreeMap::new();
     for (tid, name) in seen.into_iter().filter(|(tid, _)| !before.contains(tid)) {
         let entry = by_tid.entry(tid).or_insert_with(|| name.clone());
-        if name.starts_with(&harness::threads::WORKER_NAME[..15]) {
+        if name.starts_with(&harness::threads::WORKER_NAME[..15])
+            || name.starts_with(harness::threads::JOB_NAME)
+        {
             *entry = name;
         }
     }
@@ -106,12 +111,15 @@ fn threads_during_run(count: &str) -> BTreeSet<(u64, String)> {
 fn threads_n_runs_n_workers_and_nothing_else() {
     // Linux cuts thread names to 15 bytes.
     let worker = &harness::threads::WORKER_NAME[..15];
-    for n in [1usize, 2] {
-        let extra = threads_during_run(&n.to_string());
+    for (n, jobs) in [(1usize, 1usize), (2, 1), (1, 2)] {
+        let extra = threads_during_run(&n.to_string(), &jobs.to_string());
         let workers = extra.iter().filter(|(_, name)| name.starts_with(worker)).count();
-        // Each run builds a pool for its cases and one for its reports: n workers each.
-        assert_eq!(workers, 2 * n, "--threads {n}: {extra:?}");
+        let job_threads =
+            extra.iter().filter(|(_, name)| name.starts_with(harness::threads::JOB_NAME)).count();
+        // Each job has a pool of n for its cases, and the reports have one pool of n.
+        assert_eq!(workers, jobs * n + n, "--threads {n} --jobs {jobs}: {extra:?}");
+        assert_eq!(job_threads, jobs, "--threads {n} --jobs {jobs}: {extra:?}");
         // The sampler is the only other thread (no global rayon pool, no stray worker).
-        assert_eq!(extra.len(), workers + 1, "--threads {n}: {extra:?}");
+        assert_eq!(extra.len(), workers + job_threads + 1, "--threads {n} --jobs {jobs}: {extra:?}");
     }
 }

@@ -177,9 +177,15 @@ struct Common {
     quiet: bool,
     /// Worker threads of every method: our methods' thread pool, and OMP_NUM_THREADS,
     /// OPENBLAS_NUM_THREADS, MKL_NUM_THREADS and IGL_NUM_THREADS of external programs
-    /// [default: every logical core]. `--threads 1` is like for like with single-threaded peers.
+    /// [default: the logical cores shared among the --jobs, at least 1]. `--threads 1` is like for
+    /// like with single-threaded peers.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     threads: Option<u32>,
+    /// Cases run at a time, each with its own --threads workers (for machines with many cores;
+    /// J x threads should not exceed the logical cores). Concurrent cases disturb each other's
+    /// timings: see the README, "Timings".
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    jobs: u32,
     /// Time each case N times, each with a fresh method instance (a fresh process for an external
     /// method): timing columns give the median with min and max; the measures come from the first
     /// repetition, and a later result that is not bitwise the first makes the case `suspect:
@@ -216,7 +222,10 @@ impl Common {
             scenarios,
             methods,
             peers: None,
-            threads: self.threads.map_or_else(crate::threads::default_threads, |t| t as usize),
+            threads: self
+                .threads
+                .map_or_else(|| crate::threads::default_threads(self.jobs as usize), |t| t as usize),
+            jobs: self.jobs as usize,
             command_line: command_line.to_vec(),
             repetitions: self.repeat as usize,
             progress: !self.quiet,

@@ -64,9 +64,9 @@ pub struct RunRecord {
 const UNKNOWN: &str = "unknown";
 
 impl Provenance {
-    /// The record of a run started now with `command_line` on `threads` worker threads, each case
-    /// timed `repetitions` times.
-    pub fn record(command_line: Vec<String>, threads: usize, repetitions: usize) -> Self {
+    /// The record of a run started now with `command_line`: `jobs` cases at a time, each on `threads`
+    /// worker threads and timed `repetitions` times.
+    pub fn record(command_line: Vec<String>, threads: usize, jobs: usize, repetitions: usize) -> Self {
         Provenance {
             machine: Machine::read(),
             build: Build::read(),
@@ -74,7 +74,7 @@ impl Provenance {
                 started_utc: utc_timestamp(std::time::SystemTime::now()),
                 command_line,
                 threads,
-                jobs: 1,
+                jobs,
                 repetitions,
             },
             inputs: Vec::new(),
@@ -136,7 +136,7 @@ impl Machine {
             .unwrap_or_else(|_| UNKNOWN.into());
         Machine {
             cpu_model,
-            logical_cores: crate::threads::default_threads(),
+            logical_cores: crate::threads::default_threads(1),
             memory_gib: memory_kib / (1024.0 * 1024.0),
             os,
             kernel,
@@ -265,7 +265,7 @@ mod tests {
 
     #[test]
     fn the_record_of_this_machine_is_sane() {
-        let p = Provenance::record(vec!["harness".into(), "all".into()], 3, 1);
+        let p = Provenance::record(vec!["harness".into(), "all".into()], 3, 2, 1);
         assert!(p.machine.logical_cores >= 1);
         assert!(p.machine.memory_gib > 0.1 && p.machine.memory_gib < 1e5, "{}", p.machine.memory_gib);
         assert!(!p.machine.cpu_model.is_empty() && !p.machine.kernel.is_empty());
@@ -274,10 +274,10 @@ mod tests {
         if let Some(commit) = &p.build.git_commit {
             assert!(commit.len() == 40 && commit.chars().all(|c| c.is_ascii_hexdigit()), "{commit}");
         }
-        assert_eq!((p.run.threads, p.run.jobs, p.run.repetitions), (3, 1, 1));
+        assert_eq!((p.run.threads, p.run.jobs, p.run.repetitions), (3, 2, 1));
         assert!(p.run.started_utc.starts_with("20") && p.run.started_utc.ends_with('Z'));
         let line = p.summary();
-        assert!(line.contains("3 thread(s)") && line.contains(&p.machine.kernel), "{line}");
+        assert!(line.contains("3 thread(s), 2 job(s)") && line.contains(&p.machine.kernel), "{line}");
     }
 
     #[test]

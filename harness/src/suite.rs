@@ -2,6 +2,8 @@
 //! input stops the run before anything is written.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::OnceLock;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -45,6 +47,8 @@ pub struct SuiteOptions {
     pub peers: Option<PeerSetup>,
     /// Worker threads of every method ([`crate::threads`]).
     pub threads: usize,
+    /// Cases run at a time, each in its own pool of `threads` workers (`--jobs`).
+    pub jobs: usize,
     /// Repetitions of each case's timed phases (`--repeat`).
     pub repetitions: usize,
     /// The command that asked for the run, for its record.
@@ -188,20 +192,20 @@ fn plan(options: &SuiteOptions, catalog: &MethodCatalog, scenarios: &[LoadedScen
 /// the others can be compared with it; results are reported in registry order.
 pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
     let mut provenance =
-        Provenance::record(options.command_line.clone(), options.threads, options.repetitions);
+        Provenance::record(options.command_line.clone(), options.threads, options.jobs, options.repetitions);
     let (config, scenarios, source) = prepare(options)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let plan = plan(options, &config.catalog, &scenarios);
     let results = run_plan(options, &config, &scenarios, &plan)?;
     provenance.external = crate::provenance::external_records(&results);
     let data_source = describe_data(&source, &scenarios);
-    Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source, provenance })
+    Ok(SuiteRun { notes: notes_of(options, &scenarios), results, scenarios, data_source, provenance })
 }
 
 /// Run the scenarios of part `shard` of the suite ([`crate::shard::assign`] on their estimated cost).
 pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, HarnessError> {
     let mut provenance =
-        Provenance::record(options.command_line.clone(), options.threads, options.repetitions);
+        Provenance::record(options.command_line.clone(), options.threads, options.jobs, options.repetitions);
     let (config, scenarios, source) = prepare(options)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let data_source = describe_data(&source, &scenarios);
@@ -222,7 +226,7 @@ pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, Harne
     let scenarios: Vec<LoadedScenario> = mine.into_iter().map(|(s, _)| s).collect();
     let results = run_plan(options, &config, &scenarios, &plan)?;
     provenance.external = crate::provenance::external_records(&results);
-    Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source, provenance })
+    Ok(SuiteRun { notes: notes_of(options, &scenarios), results, scenarios, data_source, provenance })
 }
 
 /// Every file the run read: the configuration, each scenario file and what it named.
@@ -237,81 +241,152 @@ fn inputs_of(options: &SuiteOptions, scenarios: &[LoadedScenario]) -> Vec<PathBu
     paths
 }
 
-/// The notes of every scenario, each named.
-fn notes_of(scenarios: &[LoadedScenario]) -> Vec<String> {
-    scenarios
+/// The notes of every scenario, each named, and what concurrent cases do to the timings.
+fn notes_of(options: &SuiteOptions, scenarios: &[LoadedScenario]) -> Vec<String> {
+    let mut notes: Vec<String> = scenarios
         .iter()
         .flat_map(|s| s.notes.iter().map(move |n| format!("scenario `{}`: {n}", s.spec.name)))
-        .collect()
+        .collect();
+    if options.jobs > 1 {
+        notes.push(format!(
+            "cases ran {} at a time (--jobs), each on {} thread(s): they share the memory bandwidth and caches, \
+             so their timings are not those of a case run alone (README, \"Timings\")",
+            options.jobs, options.threads
+        ));
+    }
+    notes
 }
 
-/// Run `plan[i]` (method names) on `scenarios[i]` for every `i`.
+/// Run `plan[i]` (method names) on `scenarios[i]` for every `i`, `options.jobs` cases at a time,
+/// each job in its own pool of `options.threads` workers. Every scenario's [`REFERENCE_METHOD`] case
+/// is queued before the others, which wait for it (or run it) when they need its shape; results come
+/// back in plan order whatever the order they ran in, so a run's report does not depend on `jobs`.
 fn run_plan(
     options: &SuiteOptions,
     config: &RunConfig,
     scenarios: &[LoadedScenario],
     plan: &[Vec<String>],
 ) -> Result<Vec<CaseResult>, HarnessError> {
-    let pool = crate::threads::pool(options.threads)?;
-    Ok(pool.install(|| run_cases(options, config, scenarios, plan)))
-}
-
-/// [`run_plan`]'s cases, in the calling thread pool.
-fn run_cases(
-    options: &SuiteOptions,
-    config: &RunConfig,
-    scenarios: &[LoadedScenario],
-    plan: &[Vec<String>],
-) -> Vec<CaseResult> {
-    let total: usize = plan.iter().map(Vec::len).sum();
-    let bar = if options.progress { ProgressBar::new(total as u64) } else { ProgressBar::hidden() };
+    let jobs = options.jobs.max(1);
+    let pools: Vec<rayon::ThreadPool> =
+        (0..jobs).map(|_| crate::threads::pool(options.threads)).collect::<Result<_, _>>()?;
+    let queue: Vec<(usize, &str)> = {
+        let planned =
+            || plan.iter().enumerate().flat_map(|(s, names)| names.iter().map(move |m| (s, m.as_str())));
+        let (references, others): (Vec<_>, Vec<_>) = planned().partition(|(_, m)| *m == REFERENCE_METHOD);
+        references.into_iter().chain(others).collect()
+    };
+    let bar = if options.progress { ProgressBar::new(queue.len() as u64) } else { ProgressBar::hidden() };
     bar.set_style(
         ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {msg}")
             .expect("static template")
             .progress_chars("=> "),
     );
-    let mut results = Vec::with_capacity(total);
-    for (scenario, names) in scenarios.iter().zip(plan) {
-        let rest = RestGeometry::new(&scenario.mesh, &scenario.topology);
-        let mut order: Vec<&str> = names.iter().map(String::as_str).collect();
-        order.sort_by_key(|m| *m != REFERENCE_METHOD);
-        let mut cases: Vec<CaseResult> = Vec::with_capacity(order.len());
-        for method in order {
-            let method = config.catalog.get(method).expect("planned from the catalog");
-            bar.set_message(format!("{} / {}", scenario.spec.name, method.name));
-            let reference = if method.name == REFERENCE_METHOD {
-                Reference::Itself
-            } else {
-                cases
-                    .iter()
-                    .find(|c| c.method == REFERENCE_METHOD)
-                    .and_then(|c| c.positions.as_deref())
-                    .map_or(Reference::Missing, Reference::Of)
-            };
-            let stderr_log = method.is_external().then(|| {
-                options
-                    .reports_dir
-                    .join("logs")
-                    .join(format!("{}-{}.stderr.txt", scenario.spec.name, method.name))
-            });
-            let case = run_case(
-                scenario,
-                &rest,
-                method,
-                stderr_log,
-                options.threads,
-                options.repetitions,
-                &config.rules,
-                reference,
-            );
-            cases.push(case);
-            bar.inc(1);
-        }
-        cases.sort_by_key(|c| names.iter().position(|m| *m == c.method));
-        results.extend(cases);
-    }
+    let shared = SharedCases {
+        options,
+        config,
+        scenarios,
+        rests: scenarios.iter().map(|_| OnceLock::new()).collect(),
+        references: scenarios.iter().map(|_| OnceLock::new()).collect(),
+        plans_reference: plan.iter().map(|names| names.iter().any(|m| m == REFERENCE_METHOD)).collect(),
+        bar: &bar,
+    };
+    let next = AtomicUsize::new(0);
+    let done: Vec<(usize, CaseResult)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = pools
+            .iter()
+            .enumerate()
+            .map(|(j, pool)| {
+                let (shared, queue, next) = (&shared, &queue, &next);
+                std::thread::Builder::new()
+                    .name(format!("{}-{j}", crate::threads::JOB_NAME))
+                    .spawn_scoped(scope, move || {
+                        pool.install(|| {
+                            let mut mine = Vec::new();
+                            loop {
+                                let i = next.fetch_add(1, Ordering::Relaxed);
+                                let Some(&(s, method)) = queue.get(i) else { break mine };
+                                if let Some(case) = shared.run(s, method) {
+                                    mine.push((s, case));
+                                }
+                                shared.bar.inc(1);
+                            }
+                        })
+                    })
+                    .expect("spawning a job thread")
+            })
+            .collect();
+        workers.into_iter().flat_map(|w| w.join().expect("a job thread panicked")).collect()
+    });
     bar.finish_and_clear();
-    results
+    let mut by_scenario: Vec<Vec<CaseResult>> = plan.iter().map(|_| Vec::new()).collect();
+    for (s, case) in done {
+        by_scenario[s].push(case);
+    }
+    for (s, reference) in shared.references.into_iter().enumerate() {
+        by_scenario[s].extend(reference.into_inner());
+    }
+    Ok(by_scenario
+        .into_iter()
+        .zip(plan)
+        .flat_map(|(mut cases, names)| {
+            cases.sort_by_key(|c| names.iter().position(|m| *m == c.method));
+            cases
+        })
+        .collect())
+}
+
+/// What the jobs of [`run_plan`] share: each scenario's rest geometry and reference case, computed
+/// by whichever job needs them first (the others wait).
+struct SharedCases<'a> {
+    options: &'a SuiteOptions,
+    config: &'a RunConfig,
+    scenarios: &'a [LoadedScenario],
+    rests: Vec<OnceLock<RestGeometry>>,
+    references: Vec<OnceLock<CaseResult>>,
+    /// Whether scenario `s` runs the reference at all.
+    plans_reference: Vec<bool>,
+    bar: &'a ProgressBar,
+}
+
+impl SharedCases<'_> {
+    /// Run `method` on scenario `s`; `None` for the reference, which stays in `references`.
+    fn run(&self, s: usize, method: &str) -> Option<CaseResult> {
+        if method == REFERENCE_METHOD {
+            self.references[s].get_or_init(|| self.run_case(s, method, Reference::Itself));
+            return None;
+        }
+        let reference = if self.plans_reference[s] {
+            let r = self.references[s].get_or_init(|| self.run_case(s, REFERENCE_METHOD, Reference::Itself));
+            r.positions.as_deref().map_or(Reference::Missing, Reference::Of)
+        } else {
+            Reference::Missing
+        };
+        Some(self.run_case(s, method, reference))
+    }
+
+    fn run_case(&self, s: usize, method: &str, reference: Reference<'_>) -> CaseResult {
+        let scenario = &self.scenarios[s];
+        let method = self.config.catalog.get(method).expect("planned from the catalog");
+        self.bar.set_message(format!("{} / {}", scenario.spec.name, method.name));
+        let rest = self.rests[s].get_or_init(|| RestGeometry::new(&scenario.mesh, &scenario.topology));
+        let stderr_log = method.is_external().then(|| {
+            self.options
+                .reports_dir
+                .join("logs")
+                .join(format!("{}-{}.stderr.txt", scenario.spec.name, method.name))
+        });
+        run_case(
+            scenario,
+            rest,
+            method,
+            stderr_log,
+            self.options.threads,
+            self.options.repetitions,
+            &self.config.rules,
+            reference,
+        )
+    }
 }
 
 /// The run that the partial reports in `dirs` (of `all --shard K/N` with these `options`, K = 1..N)
@@ -320,7 +395,7 @@ fn run_cases(
 /// N), a case of a scenario the options do not load, a mesh that does not fit its scenario.
 pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, HarnessError> {
     let mut provenance =
-        Provenance::record(options.command_line.clone(), options.threads, options.repetitions);
+        Provenance::record(options.command_line.clone(), options.threads, options.jobs, options.repetitions);
     let (config, scenarios, source) = prepare(options)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let data_source = describe_data(&source, &scenarios);
@@ -385,7 +460,7 @@ pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, Harne
     }
     results.sort_by_key(|(i, order, _)| (*i, *order));
     let results: Vec<CaseResult> = results.into_iter().map(|(_, _, c)| c).collect();
-    Ok(SuiteRun { notes: notes_of(&scenarios), results, scenarios, data_source, provenance })
+    Ok(SuiteRun { notes: notes_of(options, &scenarios), results, scenarios, data_source, provenance })
 }
 
 /// One line on where the meshes of `scenarios` came from.
