@@ -728,6 +728,101 @@ fn jobs_run_cases_at_once_and_report_what_one_job_does() {
     assert!(page.contains("1 thread(s), 2 job(s)"), "the page says how the cases ran");
 }
 
+#[test]
+fn compare_calls_a_slower_method_slower_and_says_what_differs_between_the_runs() {
+    let scenario = (
+        "bar.toml".to_string(),
+        "name = \"bar\"\nprocedural = { shape = \"bar\", vertices = 1500 }\n\
+         methods = [\"laplacian\", \"arap\", \"isolines\"]\n"
+            .to_string(),
+    );
+    let configs = configs_with(std::slice::from_ref(&scenario));
+    // B: arap without Anderson acceleration (and room to converge without it).
+    let plain = configs_with(&[scenario]);
+    let methods = std::fs::read_to_string(plain.path().join("methods.toml")).unwrap();
+    let arap = methods.find("[arap]").unwrap();
+    let tail = methods[arap..]
+        .replacen("acceleration = \"anderson\"", "acceleration = \"none\"", 1)
+        .replacen("max_iterations = 1000", "max_iterations = 20000", 1);
+    std::fs::write(plain.path().join("methods.toml"), format!("{}{tail}", &methods[..arap])).unwrap();
+    let work = tempfile::tempdir().unwrap();
+    let dir = |name: &str| work.path().join(name).to_str().unwrap().to_string();
+    let ok = std::process::ExitCode::SUCCESS;
+    for (name, configs, repeat) in [("a", &configs, "3"), ("b", &plain, "3"), ("once", &configs, "1")] {
+        let args = [
+            "all",
+            "--quiet",
+            "--no-check",
+            "--repeat",
+            repeat,
+            "--configs",
+            configs.path().to_str().unwrap(),
+        ];
+        assert_eq!(run(&[&args[..], &["--reports", &dir(name)]].concat()).unwrap(), ok, "{name}");
+    }
+    let read = |name: &str| harness::comparison::ComparedRun::read(Path::new(&dir(name))).unwrap();
+    let (a, b, once) = (read("a"), read("b"), read("once"));
+
+    let plain_arap = harness::comparison::compare(&a, &b, harness::comparison::DEFAULT_MIN_CHANGE);
+    let arap = plain_arap.cases.iter().find(|c| c.method == "arap").unwrap();
+    assert_eq!(arap.speed(), harness::comparison::Speed::Slower, "{arap:?}");
+    assert!(arap.iterations.1 > 2 * arap.iterations.0, "{:?}", arap.iterations);
+    assert!(arap.total().ratio > 1.5, "{arap:?}");
+    assert!(!arap.is_worse(), "the same fixed point: {:?}", arap.quality);
+    assert!(
+        plain_arap.warnings.iter().any(|w| w.contains("/methods.toml differ")),
+        "the changed configuration is named: {:?}",
+        plain_arap.warnings
+    );
+    // A run compared with itself: nothing slower, faster or worse.
+    let itself = harness::comparison::compare(&a, &read("a"), harness::comparison::DEFAULT_MIN_CHANGE);
+    let t = itself.tally();
+    assert_eq!((t.slower, t.faster, t.worse, t.better, t.not_judged), (0, 0, 0, 0, 0), "{t:?}");
+    // (A working tree with uncommitted changes is worth a warning, but not this test's business.)
+    let warnings: Vec<&String> = itself.warnings.iter().filter(|w| !w.contains("uncommitted")).collect();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    // One repetition has no spread: nothing judged, and a warning says why.
+    let unjudged = harness::comparison::compare(&once, &a, harness::comparison::DEFAULT_MIN_CHANGE);
+    assert_eq!(unjudged.tally().not_judged, 3);
+    assert!(
+        unjudged.warnings.iter().any(|w| w.contains("A timed each case once")),
+        "{:?}",
+        unjudged.warnings
+    );
+    assert!(unjudged.warnings.iter().any(|w| w.contains("different repetitions: A ran with 1, B with 3")));
+
+    // The command: printed, written, and its exit codes.
+    let out = dir("comparison");
+    let compare = |extra: &[&str]| {
+        run(&[&["compare", &dir("a"), &dir("b"), "--out", &out][..], extra].concat()).unwrap()
+    };
+    assert_eq!(compare(&[]), ok);
+    assert_eq!(compare(&["--fail-on", "worse"]), ok);
+    assert_eq!(
+        compare(&["--fail-on", "slower,worse"]),
+        std::process::ExitCode::from(harness::cli::EXIT_SLOWER)
+    );
+    let md = std::fs::read_to_string(work.path().join("comparison/compare.md")).unwrap();
+    assert!(md.contains("| bar | arap |") && md.contains("slower"), "{md}");
+    let html = std::fs::read_to_string(work.path().join("comparison/compare.html")).unwrap();
+    assert!(html.contains("<tr class=\"slower\">") && html.contains("class=\"warning\""), "{html}");
+    // A quality regression fails --fail-on worse: B's results.json with arap's E_theta made worse.
+    let mut results = read_json(&work.path().join("a/results.json"));
+    let cases = results["cases"].as_array_mut().unwrap();
+    let case = cases.iter_mut().find(|c| c["method"] == "arap").unwrap();
+    case["e_theta_deg"] = serde_json::json!(case["e_theta_deg"].as_f64().unwrap() * 1.5 + 1.0);
+    let worse = work.path().join("worse.json");
+    std::fs::write(&worse, serde_json::to_vec(&results).unwrap()).unwrap();
+    let code =
+        run(&["compare", &dir("a"), worse.to_str().unwrap(), "--out", &out, "--fail-on", "worse"]).unwrap();
+    assert_eq!(code, std::process::ExitCode::from(harness::cli::EXIT_REGRESSION));
+    let md = std::fs::read_to_string(work.path().join("comparison/compare.md")).unwrap();
+    assert!(md.contains("worse: bar / arap / e_theta_deg"), "{md}");
+    // Not a run: an error that names it.
+    let e = format!("{:#}", run(&["compare", &dir("a"), &dir("nowhere")]).unwrap_err());
+    assert!(e.contains("nowhere") && e.contains("results.json"), "{e}");
+}
+
 /// The procedural bar written to `dir` as GLB, then the mesh read back from it written as OFF and
 /// binary PLY, so all three files hold the same numbers (GLB stores f32 positions).
 fn bar_in_three_formats(dir: &Path) {

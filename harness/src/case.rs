@@ -164,6 +164,54 @@ pub struct TimingSpread {
     pub total_s: Spread,
 }
 
+/// The phases of a case that are timed over the repetitions, in report order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TimedPhase {
+    Precompute,
+    Bind,
+    Solve,
+    Total,
+}
+
+impl TimedPhase {
+    pub const ALL: [TimedPhase; 4] =
+        [TimedPhase::Precompute, TimedPhase::Bind, TimedPhase::Solve, TimedPhase::Total];
+
+    /// The results column.
+    pub fn key(self) -> &'static str {
+        match self {
+            TimedPhase::Precompute => "precompute_s",
+            TimedPhase::Bind => "bind_s",
+            TimedPhase::Solve => "solve_s",
+            TimedPhase::Total => "total_s",
+        }
+    }
+
+    /// The median (the only value, after one repetition) of `case`, seconds.
+    pub fn median(self, case: &CaseResult) -> f64 {
+        match self {
+            TimedPhase::Precompute => case.precompute_s,
+            TimedPhase::Bind => case.bind_s,
+            TimedPhase::Solve => case.solve_s,
+            TimedPhase::Total => case.total_s,
+        }
+    }
+
+    /// Min and max of `case` over its repetitions (the median twice after one), seconds.
+    pub fn spread(self, case: &CaseResult) -> Spread {
+        let Some(spread) = case.spread else {
+            let v = self.median(case);
+            return Spread { min: v, max: v };
+        };
+        match self {
+            TimedPhase::Precompute => spread.precompute_s,
+            TimedPhase::Bind => spread.bind_s,
+            TimedPhase::Solve => spread.solve_s,
+            TimedPhase::Total => spread.total_s,
+        }
+    }
+}
+
 /// The timed phases of one repetition of a case.
 #[derive(Clone, Copy, Debug)]
 struct Timings {

@@ -1,4 +1,4 @@
-//! The command line of the harness (`all`, `run`, `check`, `baseline`, `list`): the CLI edge, where
+//! The command line of the harness (`all`, `run`, `merge`, `check`, `baseline`, `compare`, `list`): the CLI edge, where
 //! errors become `anyhow` messages and exit codes. In the library so the end-to-end tests drive
 //! exactly what the binary runs.
 
@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use crate::case::CaseResult;
+use crate::comparison::ComparedRun;
 use crate::config::PeerSetup;
 use crate::metrics::METRICS;
 use crate::peers;
@@ -93,8 +94,36 @@ enum Command {
         #[command(flatten)]
         gate: Gate,
     },
+    /// Compare run B with run A (report directories or results.json files): per case and method the
+    /// ratio of the timing medians, judged against their spread (`--repeat`), and every quality
+    /// change against the gate's tolerances; printed and written as compare.md and compare.html.
+    Compare {
+        /// The earlier run, or the reference.
+        a: PathBuf,
+        /// The run judged against A.
+        b: PathBuf,
+        /// Where compare.md and compare.html go [default: reports/comparison in the workspace].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Exit non-zero when some case is slower (exit 4) or worse in quality (exit 3).
+        #[arg(long, value_enum, value_delimiter = ',')]
+        fail_on: Vec<FailOn>,
+        /// The smallest change of a median, as a fraction, that is called slower or faster even when
+        /// the min–max ranges do not overlap.
+        #[arg(long, default_value_t = crate::comparison::DEFAULT_MIN_CHANGE)]
+        min_change: f64,
+    },
     /// List the registered methods and the scenarios.
     List(Common),
+}
+
+/// What makes `compare` exit non-zero.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum FailOn {
+    /// Some case's total time is slower beyond its spread.
+    Slower,
+    /// Some case is worse in quality, failed or turned suspect or unfinished.
+    Worse,
 }
 
 #[derive(Args, Clone)]
@@ -237,8 +266,11 @@ impl Common {
 pub const EXIT_CASE_FAILED: u8 = 1;
 /// Exit code of bad input or I/O errors (nothing written).
 pub const EXIT_ERROR: u8 = 2;
-/// Exit code of a run or check that found quality regressions against the baseline.
+/// Exit code of a run or check that found quality regressions against the baseline (and of
+/// `compare --fail-on worse` that found a worse case).
 pub const EXIT_REGRESSION: u8 = 3;
+/// Exit code of `compare --fail-on slower` that found a slower case.
+pub const EXIT_SLOWER: u8 = 4;
 
 /// Parse `args` (program name first) and run. `Err` means bad input or I/O failure: the caller prints
 /// it and exits with [`EXIT_ERROR`]; argument errors exit inside clap as usual.
@@ -298,6 +330,30 @@ where
             let dir = common.options(Vec::new(), Vec::new(), &command_line).reports_dir;
             let (path, cases) = pipeline::write_baseline(&dir, gate.baseline.as_deref())?;
             println!("baseline: {cases} cases from {} written to {}", dir.display(), path.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Compare { a, b, out, fail_on, min_change } => {
+            anyhow::ensure!(
+                (0.0..1.0).contains(&min_change),
+                "--min-change {min_change}: a fraction in [0, 1), e.g. 0.05 for 5%"
+            );
+            let (a, b) = (ComparedRun::read(&a)?, ComparedRun::read(&b)?);
+            let comparison = crate::comparison::compare(&a, &b, min_change);
+            let out = out.unwrap_or_else(|| suite::workspace_root().join("reports/comparison"));
+            crate::report::write_comparison(&out, &comparison)
+                .with_context(|| format!("writing the comparison to {}", out.display()))?;
+            // The warnings head the printed markdown.
+            println!("{}", crate::report::run_comparison::render_markdown(&comparison));
+            println!("comparison: {} (compare.md, compare.html)", out.display());
+            let tally = comparison.tally();
+            if fail_on.contains(&FailOn::Worse) && tally.worse > 0 {
+                eprintln!("error: {} case(s) worse in quality", tally.worse);
+                return Ok(ExitCode::from(EXIT_REGRESSION));
+            }
+            if fail_on.contains(&FailOn::Slower) && tally.slower > 0 {
+                eprintln!("error: {} case(s) slower", tally.slower);
+                return Ok(ExitCode::from(EXIT_SLOWER));
+            }
             Ok(ExitCode::SUCCESS)
         }
         Command::List(common) => {

@@ -3,6 +3,7 @@
 
 pub mod case;
 pub mod cli;
+pub mod comparison;
 pub mod config;
 pub mod error;
 pub mod metrics;

@@ -104,26 +104,46 @@ impl fmt::Display for Finding {
         match self {
             Finding::Worse { scenario, method, metric, baseline, current } => write!(
                 f,
-                "worse: {scenario} / {method} / {metric}: {current:.4} against baseline {baseline:.4} (+{:.1}%)",
-                100.0 * (metric.badness(*current) - metric.badness(*baseline))
-                    / baseline.abs().max(f64::MIN_POSITIVE)
+                "worse: {scenario} / {method} / {metric}: {current:.4} against baseline {baseline:.4} ({})",
+                change_text(*metric, *baseline, *current)
             ),
             Finding::Turned { scenario, method, from, status } => {
                 let to = status.split(':').next().unwrap_or(status);
                 write!(f, "turned {to}: {scenario} / {method} ({from} in the baseline): {status}")
             }
-            Finding::Failed { scenario, method, status } => write!(f, "failed: {scenario} / {method}: {status}"),
+            Finding::Failed { scenario, method, status } => {
+                write!(f, "failed: {scenario} / {method}: {status}")
+            }
             Finding::NonFinite { scenario, method, metric } => {
                 write!(f, "non-finite: {scenario} / {method} / {metric}")
             }
-            Finding::Missing { scenario, method } => write!(f, "missing: {scenario} / {method} (in the baseline, not in the run)"),
-            Finding::Better { scenario, method, metric, baseline, current } => {
-                write!(f, "better: {scenario} / {method} / {metric}: {current:.4} against baseline {baseline:.4}")
+            Finding::Missing { scenario, method } => {
+                write!(f, "missing: {scenario} / {method} (in the baseline, not in the run)")
             }
+            Finding::Better { scenario, method, metric, baseline, current } => write!(
+                f,
+                "better: {scenario} / {method} / {metric}: {current:.4} against baseline {baseline:.4} ({})",
+                change_text(*metric, *baseline, *current)
+            ),
             Finding::Improved { scenario, method, from, to } => {
                 write!(f, "now {to}: {scenario} / {method} ({from} in the baseline)")
             }
         }
+    }
+}
+
+/// How much `metric` got worse (positive) or better (negative) from `baseline` to `current`: in per
+/// cent of the baseline, unless the baseline is within the metric's absolute tolerance of 0 (a fold
+/// count of 0, say), where a percentage means nothing and the change is given as it is.
+fn change_text(metric: Metric, baseline: f64, current: f64) -> String {
+    let change = metric.badness(current) - metric.badness(baseline);
+    let absolute = metric.spec().gate.map_or(0.0, |t| t.absolute);
+    if baseline == 0.0 {
+        format!("{change:+.3e} from 0")
+    } else if baseline.abs() <= absolute {
+        format!("{change:+.3e}, from {baseline:.3e}, within the tolerance {absolute:.0e} of 0")
+    } else {
+        format!("{:+.1}%", 100.0 * change / baseline.abs())
     }
 }
 
@@ -417,6 +437,23 @@ mod tests {
         assert!(texts.iter().any(|t| t.starts_with("non-finite: bar / arap / e_phi_deg")), "{texts:?}");
         assert!(texts.iter().any(|t| t.starts_with("failed: bar / laplacian: failed: solver")), "{texts:?}");
         assert!(texts.iter().any(|t| t.starts_with("missing: cactus / arap")), "{texts:?}");
+    }
+
+    #[test]
+    fn a_change_from_zero_is_said_as_such() {
+        // Folds from 0 to 0.001: a percentage of 0 would be astronomic.
+        let mut base = run();
+        base[0].quality.set(Metric::Folds, Some(0.0));
+        let mut r = run();
+        r[0].quality.set(Metric::Folds, Some(0.001));
+        let findings = check(&baseline_from(&base), &r);
+        let text = findings.iter().map(|f| f.to_string()).collect::<Vec<_>>().join("\n");
+        assert!(text.contains("(+1.000e-3 from 0)"), "{text}");
+        assert!(!text.contains('%'), "{text}");
+        // From a non-zero value: per cent.
+        base[0].quality.set(Metric::Folds, Some(0.01));
+        let text = check(&baseline_from(&base), &r)[0].to_string();
+        assert!(text.starts_with("better:") && text.contains("(-90.0%)"), "{text}");
     }
 
     #[test]

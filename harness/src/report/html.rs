@@ -13,7 +13,7 @@ use crate::metrics::METRICS;
 use crate::regression::GateOutcome;
 
 /// Escape text for HTML element content and attribute values.
-fn escape(text: &str) -> String {
+pub(crate) fn escape(text: &str) -> String {
     text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 

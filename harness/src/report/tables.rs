@@ -408,6 +408,13 @@ fn write_meshes(
     Ok(())
 }
 
+/// Write `compare.md` and `compare.html` of `comparison` under `dir`.
+pub fn write_comparison(dir: &Path, comparison: &crate::comparison::Comparison) -> Result<(), HarnessError> {
+    std::fs::create_dir_all(dir).map_err(|error| HarnessError::Io { path: dir.to_path_buf(), error })?;
+    write_bytes(&dir.join("compare.md"), super::run_comparison::render_markdown(comparison).as_bytes())?;
+    write_bytes(&dir.join("compare.html"), super::run_comparison::render_html(comparison).as_bytes())
+}
+
 fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), HarnessError> {
     meshes::io::atomic_write(path, |w| w.write_all(bytes).map_err(meshes::MeshError::from))
         .map_err(HarnessError::from)
