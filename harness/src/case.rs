@@ -162,26 +162,61 @@ pub struct TimingSpread {
     pub bind_s: Spread,
     pub solve_s: Spread,
     pub total_s: Spread,
+    /// The median iteration of each repetition, milliseconds.
+    #[serde(default = "Spread::unknown")]
+    pub median_iteration_ms: Spread,
+    /// An external method's start-up (NaN for a built-in method).
+    #[serde(default = "Spread::unknown")]
+    pub startup_s: Spread,
+}
+
+impl Spread {
+    /// No spread known (a report of an older harness).
+    pub fn unknown() -> Spread {
+        Spread { min: f64::NAN, max: f64::NAN }
+    }
 }
 
 /// The phases of a case that are timed over the repetitions, in report order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TimedPhase {
+    Startup,
     Precompute,
     Bind,
+    Iteration,
     Solve,
     Total,
 }
 
 impl TimedPhase {
-    pub const ALL: [TimedPhase; 4] =
-        [TimedPhase::Precompute, TimedPhase::Bind, TimedPhase::Solve, TimedPhase::Total];
+    pub const ALL: [TimedPhase; 6] = [
+        TimedPhase::Startup,
+        TimedPhase::Precompute,
+        TimedPhase::Bind,
+        TimedPhase::Iteration,
+        TimedPhase::Solve,
+        TimedPhase::Total,
+    ];
+
+    /// Its name in a sentence.
+    pub fn label(self) -> &'static str {
+        match self {
+            TimedPhase::Startup => "startup",
+            TimedPhase::Precompute => "precompute",
+            TimedPhase::Bind => "bind",
+            TimedPhase::Iteration => "iteration",
+            TimedPhase::Solve => "solve",
+            TimedPhase::Total => "total",
+        }
+    }
 
     /// The results column.
     pub fn key(self) -> &'static str {
         match self {
+            TimedPhase::Startup => "startup_s",
             TimedPhase::Precompute => "precompute_s",
             TimedPhase::Bind => "bind_s",
+            TimedPhase::Iteration => "median_iteration_ms",
             TimedPhase::Solve => "solve_s",
             TimedPhase::Total => "total_s",
         }
@@ -190,8 +225,10 @@ impl TimedPhase {
     /// The median (the only value, after one repetition) of `case`, seconds.
     pub fn median(self, case: &CaseResult) -> f64 {
         match self {
+            TimedPhase::Startup => case.startup_s,
             TimedPhase::Precompute => case.precompute_s,
             TimedPhase::Bind => case.bind_s,
+            TimedPhase::Iteration => case.median_iteration_ms / 1e3,
             TimedPhase::Solve => case.solve_s,
             TimedPhase::Total => case.total_s,
         }
@@ -204,8 +241,13 @@ impl TimedPhase {
             return Spread { min: v, max: v };
         };
         match self {
+            TimedPhase::Startup => spread.startup_s,
             TimedPhase::Precompute => spread.precompute_s,
             TimedPhase::Bind => spread.bind_s,
+            TimedPhase::Iteration => Spread {
+                min: spread.median_iteration_ms.min / 1e3,
+                max: spread.median_iteration_ms.max / 1e3,
+            },
             TimedPhase::Solve => spread.solve_s,
             TimedPhase::Total => spread.total_s,
         }
@@ -215,10 +257,26 @@ impl TimedPhase {
 /// The timed phases of one repetition of a case.
 #[derive(Clone, Copy, Debug)]
 struct Timings {
+    startup_s: f64,
     precompute_s: f64,
     bind_s: f64,
+    median_iteration_ms: f64,
     solve_s: f64,
     total_s: f64,
+}
+
+/// The seconds of every iteration of a repetition (which records nothing else).
+struct IterationClock(Vec<f64>);
+
+impl IterationObserver for IterationClock {
+    fn on_iteration(
+        &mut self,
+        r: &IterationReport,
+        _: Option<&dyn Fn() -> Vec<[f64; 3]>>,
+    ) -> ControlFlow<()> {
+        self.0.push(r.seconds);
+        ControlFlow::Continue(())
+    }
 }
 
 /// Median, min and max of `values` (not empty).
@@ -237,6 +295,8 @@ fn repetition(
     threads: usize,
 ) -> Result<(Timings, Vec<[f64; 3]>), methods::MethodError> {
     let mut m = method.create(None, threads)?;
+    let startup_s = m.startup_seconds().unwrap_or(f64::NAN);
+    let mut clock = IterationClock(Vec::new());
     let start = Instant::now();
     m.precompute(&scenario.mesh)?;
     let precompute_s = start.elapsed().as_secs_f64();
@@ -249,11 +309,18 @@ fn repetition(
             first_bind_s = t.elapsed().as_secs_f64();
         }
         let t = Instant::now();
-        m.solve(&targets, &mut methods::NoObserver)?;
+        m.solve(&targets, &mut clock)?;
         solve_s += t.elapsed().as_secs_f64();
     }
     let total_s = start.elapsed().as_secs_f64();
-    Ok((Timings { precompute_s, bind_s: first_bind_s, solve_s, total_s }, m.positions()))
+    // The first repetition's median is the upper middle of an even count (median_ms): the same here.
+    let mut seconds = clock.0;
+    seconds.sort_by(f64::total_cmp);
+    let median_iteration_ms = seconds.get(seconds.len() / 2).map_or(f64::NAN, |t| 1e3 * t);
+    Ok((
+        Timings { startup_s, precompute_s, bind_s: first_bind_s, median_iteration_ms, solve_s, total_s },
+        m.positions(),
+    ))
 }
 
 /// Wall seconds the harness spent measuring one case, kept out of the method's timings.
@@ -459,8 +526,10 @@ fn repeat(
     repetitions: usize,
 ) -> Vec<String> {
     let first = Timings {
+        startup_s: result.startup_s,
         precompute_s: result.precompute_s,
         bind_s: result.bind_s,
+        median_iteration_ms: result.median_iteration_ms,
         solve_s: result.solve_s,
         total_s: result.total_s,
     };
@@ -492,14 +561,19 @@ fn repeat(
     let (bind_s, bind) = spread(|t| t.bind_s);
     let (solve_s, solve) = spread(|t| t.solve_s);
     let (total_s, total) = spread(|t| t.total_s);
+    let (median_iteration_ms, iteration) = spread(|t| t.median_iteration_ms);
+    let (startup_s, startup) = spread(|t| t.startup_s);
     (result.precompute_s, result.bind_s, result.solve_s, result.total_s) =
         (precompute_s, bind_s, solve_s, total_s);
+    (result.median_iteration_ms, result.startup_s) = (median_iteration_ms, startup_s);
     result.spread = Some(TimingSpread {
         repetitions: timings.len(),
         precompute_s: precompute,
         bind_s: bind,
         solve_s: solve,
         total_s: total,
+        median_iteration_ms: iteration,
+        startup_s: startup,
     });
     reasons
 }

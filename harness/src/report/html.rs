@@ -150,12 +150,12 @@ pub fn render_index(
             r.vertices,
             r.iterations,
             if r.converged { "yes" } else { "no" },
-            number(r.startup_s, 3),
+            timing(r.startup_s, r.spread.map(|s| (s.repetitions, s.startup_s)), 3),
             timing(r.precompute_s, r.spread.map(|s| (s.repetitions, s.precompute_s)), 3),
             timing(r.bind_s, r.spread.map(|s| (s.repetitions, s.bind_s)), 4),
             timing(r.solve_s, r.spread.map(|s| (s.repetitions, s.solve_s)), 3),
             timing(r.total_s, r.spread.map(|s| (s.repetitions, s.total_s)), 3),
-            number(r.median_iteration_ms, 3),
+            timing(r.median_iteration_ms, r.spread.map(|s| (s.repetitions, s.median_iteration_ms)), 3),
         );
         for spec in &METRICS {
             let _ = write!(page, "<td>{}</td>", escape(&spec.format.apply(r.quality.get(spec.metric))));

@@ -43,7 +43,7 @@ fn phase_notes(c: &CaseChange) -> String {
         .iter()
         .filter(|p| p.phase != crate::case::TimedPhase::Total)
         .filter(|p| matches!(p.speed, Speed::Slower | Speed::Faster))
-        .map(|p| format!("{} {} ({:.2}x)", p.phase.key().trim_end_matches("_s"), p.speed.label(), p.ratio))
+        .map(|p| format!("{} {} ({:.2}x)", p.phase.label(), p.speed.label(), p.ratio))
         .collect::<Vec<_>>()
         .join(", ")
 }

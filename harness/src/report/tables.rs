@@ -40,6 +40,10 @@ const CASE_COLUMNS: &[&str] = &[
     "solve_s_max",
     "total_s_min",
     "total_s_max",
+    "median_iteration_ms_min",
+    "median_iteration_ms_max",
+    "startup_s_min",
+    "startup_s_max",
 ];
 
 /// The CSV columns after the metrics.
@@ -137,7 +141,14 @@ pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
         ];
         let spread = r.spread.unwrap_or_default();
         row.push(spread.repetitions.to_string());
-        for s in [spread.precompute_s, spread.bind_s, spread.solve_s, spread.total_s] {
+        for s in [
+            spread.precompute_s,
+            spread.bind_s,
+            spread.solve_s,
+            spread.total_s,
+            spread.median_iteration_ms,
+            spread.startup_s,
+        ] {
             let (min, max) = if r.spread.is_some() { (s.min, s.max) } else { (f64::NAN, f64::NAN) };
             row.extend([num(min), num(max)]);
         }
