@@ -723,6 +723,9 @@ fn jobs_run_cases_at_once_and_report_what_one_job_does() {
     for (x, y) in a.iter().zip(b) {
         assert_eq!(support::timeless(x), support::timeless(y), "{} / {}", x["scenario"], x["method"]);
         assert!(x["rms_to_arap_over_diag"].is_number(), "compared with the reference");
+        // Memory is measured one case at a time only: the counter is the process's.
+        assert!(x["peak_memory_mib"].as_f64().is_some_and(|m| m >= 0.0), "{}", x["peak_memory_mib"]);
+        assert!(y["peak_memory_mib"].is_null(), "{}", y["peak_memory_mib"]);
     }
     let page = std::fs::read_to_string(work.path().join("two/index.html")).unwrap();
     assert!(page.contains("1 thread(s), 2 job(s)"), "the page says how the cases ran");

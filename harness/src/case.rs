@@ -107,6 +107,11 @@ pub struct CaseResult {
     pub solve_s: f64,
     #[serde(deserialize_with = "nan_from_null")]
     pub total_s: f64,
+    /// What the method added to the process's resident memory at its peak, from precompute to the
+    /// end of the last solve of the first repetition, MiB ([`crate::memory`]; NaN when not measured:
+    /// `--jobs` above 1, an external method, no Linux counters).
+    #[serde(default = "nan", deserialize_with = "nan_from_null")]
+    pub peak_memory_mib: f64,
     pub converged: bool,
     /// Every measure of the metric table, one JSON field per metric key (`null`: none).
     #[serde(flatten)]
@@ -256,7 +261,7 @@ impl TimedPhase {
 
 /// The timed phases of one repetition of a case.
 #[derive(Clone, Copy, Debug)]
-struct Timings {
+pub(crate) struct Timings {
     startup_s: f64,
     precompute_s: f64,
     bind_s: f64,
@@ -287,9 +292,9 @@ fn median_spread(mut values: Vec<f64>) -> (f64, Spread) {
     (median, Spread { min: values[0], max: values[n - 1] })
 }
 
-/// One more repetition of `method` on `scenario`: a fresh instance through every edit step, no
-/// observer; its timings and final `#V x 3` positions.
-fn repetition(
+/// One more repetition of `method` on `scenario` (a round of `--repeat`): a fresh instance through
+/// every edit step, observed only for its iteration times; its timings and final `#V x 3` positions.
+pub(crate) fn repetition(
     scenario: &LoadedScenario,
     method: &ConfiguredMethod,
     threads: usize,
@@ -381,20 +386,29 @@ pub enum Reference<'a> {
     Missing,
 }
 
-/// Run `method` on `scenario` (a fresh instance; an external method's stderr goes to `stderr_log`
-/// and its thread variables say `threads`), measure the result against `rest` (the scenario's rest
-/// geometry) and `reference`, and judge it by `rules`. A method error becomes a `failed` result; it
-/// does not abort the run.
+/// How the cases of a run are run.
+#[derive(Clone, Copy, Debug)]
+pub struct CaseSettings {
+    /// Worker threads (the pool the case runs in; an external method's thread variables).
+    pub threads: usize,
+    /// Measure the peak memory ([`crate::memory`]): only when one case runs at a time.
+    pub measure_memory: bool,
+}
+
+/// Run `method` on `scenario` (a fresh instance; an external method's stderr goes to `stderr_log`),
+/// as `settings` say, measure the result against `rest` (the scenario's rest geometry) and
+/// `reference`, and judge it by `rules`. A method error becomes a `failed` result; it does not abort
+/// the run.
 pub fn run_case(
     scenario: &LoadedScenario,
     rest: &RestGeometry,
     method: &ConfiguredMethod,
     stderr_log: Option<std::path::PathBuf>,
-    threads: usize,
-    repetitions: usize,
+    settings: CaseSettings,
     rules: &VerdictRules,
     reference: Reference<'_>,
 ) -> CaseResult {
+    let CaseSettings { threads, measure_memory } = settings;
     let params = &method.params;
     let mut result = CaseResult::empty(
         &scenario.spec.name,
@@ -413,6 +427,8 @@ pub fn run_case(
     let cap = params.get("max_iterations").and_then(toml::Value::as_integer).map(|c| c as usize);
     let tolerance = params.get("tolerance").and_then(toml::Value::as_float);
     let outcome = (|| -> Result<Vec<String>, methods::MethodError> {
+        let memory =
+            (measure_memory && method.origin == Origin::BuiltIn).then(crate::memory::start_peak).flatten();
         let mut m = method.create(stderr_log, threads)?;
         result.startup_s = m.startup_seconds().unwrap_or(f64::NAN);
         result.about = m.about();
@@ -468,6 +484,7 @@ pub fn run_case(
         result.bind_s = result.steps.first().map_or(f64::NAN, |s| s.bind_s);
         result.solve_s = solve_s;
         result.total_s = start.elapsed().as_secs_f64() - recorder.quality_s;
+        result.peak_memory_mib = crate::memory::peak_since(memory).unwrap_or(f64::NAN);
         result.phase_timings = m.phase_timings();
         result.statistics = m.model_statistics();
         let (step, targets) = final_edit.expect("a scenario has at least one step");
@@ -503,10 +520,6 @@ pub fn run_case(
     result.median_iteration_ms = median_ms(&recorder.trace);
     result.trace = recorder.trace;
     result.overhead.trace_quality_s = recorder.quality_s;
-    let outcome = outcome.map(|mut reasons| {
-        reasons.extend(repeat(&mut result, scenario, rest, method, threads, repetitions));
-        reasons
-    });
     result.status = match outcome {
         Ok(reasons) => Status::judge(&unfinished, reasons),
         Err(e) => Status::Failed(e.to_string()),
@@ -514,17 +527,15 @@ pub fn run_case(
     result
 }
 
-/// Repetitions 2..=`repetitions` of a case whose first one is `result`: the timings become medians
-/// with their spread; a repetition whose result is not bitwise the first's, or that fails, gives a
-/// `non-deterministic` reason.
-fn repeat(
+/// Fold the later repetitions of a case (rounds 2..N of `--repeat N`, from [`repetition`]) into
+/// `result`, its first: the timings become medians with their spread; a repetition whose result is
+/// not bitwise the first's, or that failed, makes the case `non-deterministic` (`diagonal`: the rest
+/// bounding-box diagonal, to say how far apart).
+pub(crate) fn add_repetitions(
     result: &mut CaseResult,
-    scenario: &LoadedScenario,
-    rest: &RestGeometry,
-    method: &ConfiguredMethod,
-    threads: usize,
-    repetitions: usize,
-) -> Vec<String> {
+    diagonal: f64,
+    later: Vec<Result<(Timings, Vec<[f64; 3]>), methods::MethodError>>,
+) {
     let first = Timings {
         startup_s: result.startup_s,
         precompute_s: result.precompute_s,
@@ -535,8 +546,8 @@ fn repeat(
     };
     let mut timings = vec![first];
     let mut reasons = Vec::new();
-    for k in 2..=repetitions.max(1) {
-        match repetition(scenario, method, threads) {
+    for (k, again) in (2..).zip(later) {
+        match again {
             Ok((t, positions)) => {
                 timings.push(t);
                 let reference = result.positions.as_deref().unwrap_or_default();
@@ -547,7 +558,7 @@ fn repeat(
                         .zip(reference.iter().flatten())
                         .all(|(a, b)| a.to_bits() == b.to_bits());
                 if !same && !reasons.iter().any(|r: &String| r.starts_with("non-deterministic")) {
-                    let apart = largest_displacement(reference, &positions) / rest.diagonal;
+                    let apart = largest_displacement(reference, &positions) / diagonal;
                     reasons.push(format!(
                         "non-deterministic: repetition {k}'s result differs from the first (up to {apart:.1e} of the diagonal)"
                     ));
@@ -575,7 +586,7 @@ fn repeat(
         median_iteration_ms: iteration,
         startup_s: startup,
     });
-    reasons
+    result.status.add_reasons(reasons);
 }
 
 fn nan() -> f64 {
@@ -614,6 +625,7 @@ impl CaseResult {
             iterations: 0,
             solve_s: f64::NAN,
             total_s: f64::NAN,
+            peak_memory_mib: f64::NAN,
             converged: false,
             quality: Quality::default(),
             largest_move_over_diag: f64::NAN,

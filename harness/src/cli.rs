@@ -215,10 +215,10 @@ struct Common {
     /// timings: see the README, "Timings".
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     jobs: u32,
-    /// Time each case N times, each with a fresh method instance (a fresh process for an external
-    /// method): timing columns give the median with min and max; the measures come from the first
-    /// repetition, and a later result that is not bitwise the first makes the case `suspect:
-    /// non-deterministic`.
+    /// Run the suite in N rounds: the first measures every case, each later one times every case
+    /// again with a fresh method instance (a fresh process for an external method). Timing columns
+    /// give the median with min and max; the measures come from the first round, and a later result
+    /// that is not bitwise the first makes the case `suspect: non-deterministic`.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     repeat: u32,
 }

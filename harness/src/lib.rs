@@ -6,6 +6,7 @@ pub mod cli;
 pub mod comparison;
 pub mod config;
 pub mod error;
+pub mod memory;
 pub mod metrics;
 pub mod peers;
 pub mod pipeline;

@@ -7,7 +7,7 @@ use std::sync::OnceLock;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::case::{run_case, CaseResult, Reference};
+use crate::case::{run_case, CaseResult, CaseSettings, Reference};
 use crate::config::{MethodCatalog, PeerSetup};
 use crate::error::HarnessError;
 use crate::metrics::RestGeometry;
@@ -261,22 +261,32 @@ fn notes_of(options: &SuiteOptions, scenarios: &[LoadedScenario]) -> Vec<String>
 /// each job in its own pool of `options.threads` workers. Every scenario's [`REFERENCE_METHOD`] case
 /// is queued before the others, which wait for it (or run it) when they need its shape; results come
 /// back in plan order whatever the order they ran in, so a run's report does not depend on `jobs`.
+///
+/// With `--repeat N` the suite runs in N rounds: the first measures every case, each later one
+/// times every case again ([`crate::case::repetition`]). Repeating a case N times back to back
+/// misses the machine's slow drift: two such runs of one commit on this machine called 34 of 70 cases
+/// slower or faster, with ranges that did not overlap. Rounds spread each case's repetitions over
+/// the run, as asv's `rounds` do, so the spread takes the drift in.
 fn run_plan(
     options: &SuiteOptions,
     config: &RunConfig,
     scenarios: &[LoadedScenario],
     plan: &[Vec<String>],
 ) -> Result<Vec<CaseResult>, HarnessError> {
-    let jobs = options.jobs.max(1);
     let pools: Vec<rayon::ThreadPool> =
-        (0..jobs).map(|_| crate::threads::pool(options.threads)).collect::<Result<_, _>>()?;
+        (0..options.jobs.max(1)).map(|_| crate::threads::pool(options.threads)).collect::<Result<_, _>>()?;
     let queue: Vec<(usize, &str)> = {
         let planned =
             || plan.iter().enumerate().flat_map(|(s, names)| names.iter().map(move |m| (s, m.as_str())));
         let (references, others): (Vec<_>, Vec<_>) = planned().partition(|(_, m)| *m == REFERENCE_METHOD);
         references.into_iter().chain(others).collect()
     };
-    let bar = if options.progress { ProgressBar::new(queue.len() as u64) } else { ProgressBar::hidden() };
+    let rounds = options.repetitions.max(1);
+    let bar = if options.progress {
+        ProgressBar::new((queue.len() * rounds) as u64)
+    } else {
+        ProgressBar::hidden()
+    };
     bar.set_style(
         ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {msg}")
             .expect("static template")
@@ -291,13 +301,50 @@ fn run_plan(
         plans_reference: plan.iter().map(|names| names.iter().any(|m| m == REFERENCE_METHOD)).collect(),
         bar: &bar,
     };
+    let first = in_jobs(&pools, queue.len(), |i| {
+        let (s, method) = queue[i];
+        let case = shared.run(s, method).map(|case| (s, case));
+        bar.inc(1);
+        case
+    });
+    let mut cases: Vec<(usize, CaseResult)> = first.into_iter().flatten().collect();
+    cases.extend(shared.references.into_iter().enumerate().filter_map(|(s, r)| Some((s, r.into_inner()?))));
+    cases.sort_by_key(|(s, c)| (*s, plan[*s].iter().position(|m| *m == c.method)));
+    if rounds > 1 {
+        let mut later: Vec<Vec<_>> = cases.iter().map(|_| Vec::with_capacity(rounds - 1)).collect();
+        for round in 2..=rounds {
+            bar.set_message(format!("round {round} of {rounds}"));
+            let timed = in_jobs(&pools, cases.len(), |i| {
+                let (s, case) = &cases[i];
+                let method = config.catalog.get(&case.method).expect("planned from the catalog");
+                let again = (!case.status.is_failed())
+                    .then(|| crate::case::repetition(&scenarios[*s], method, options.threads));
+                bar.inc(1);
+                again
+            });
+            for (i, again) in timed.into_iter().enumerate() {
+                later[i].extend(again);
+            }
+        }
+        for ((s, case), later) in cases.iter_mut().zip(later) {
+            let diagonal = shared.rests[*s].get().map_or(f64::NAN, |r| r.diagonal);
+            crate::case::add_repetitions(case, diagonal, later);
+        }
+    }
+    bar.finish_and_clear();
+    Ok(cases.into_iter().map(|(_, case)| case).collect())
+}
+
+/// `work(i)` for every `i < count`, `pools.len()` items at a time: one job thread per pool takes
+/// the next item and runs it inside its pool. The results in item order.
+fn in_jobs<T: Send>(pools: &[rayon::ThreadPool], count: usize, work: impl Fn(usize) -> T + Sync) -> Vec<T> {
     let next = AtomicUsize::new(0);
-    let done: Vec<(usize, CaseResult)> = std::thread::scope(|scope| {
-        let workers: Vec<_> = pools
+    let mut done: Vec<(usize, T)> = std::thread::scope(|scope| {
+        let jobs: Vec<_> = pools
             .iter()
             .enumerate()
             .map(|(j, pool)| {
-                let (shared, queue, next) = (&shared, &queue, &next);
+                let (work, next) = (&work, &next);
                 std::thread::Builder::new()
                     .name(format!("{}-{j}", crate::threads::JOB_NAME))
                     .spawn_scoped(scope, move || {
@@ -305,35 +352,20 @@ fn run_plan(
                             let mut mine = Vec::new();
                             loop {
                                 let i = next.fetch_add(1, Ordering::Relaxed);
-                                let Some(&(s, method)) = queue.get(i) else { break mine };
-                                if let Some(case) = shared.run(s, method) {
-                                    mine.push((s, case));
+                                if i >= count {
+                                    break mine;
                                 }
-                                shared.bar.inc(1);
+                                mine.push((i, work(i)));
                             }
                         })
                     })
                     .expect("spawning a job thread")
             })
             .collect();
-        workers.into_iter().flat_map(|w| w.join().expect("a job thread panicked")).collect()
+        jobs.into_iter().flat_map(|j| j.join().expect("a job thread panicked")).collect()
     });
-    bar.finish_and_clear();
-    let mut by_scenario: Vec<Vec<CaseResult>> = plan.iter().map(|_| Vec::new()).collect();
-    for (s, case) in done {
-        by_scenario[s].push(case);
-    }
-    for (s, reference) in shared.references.into_iter().enumerate() {
-        by_scenario[s].extend(reference.into_inner());
-    }
-    Ok(by_scenario
-        .into_iter()
-        .zip(plan)
-        .flat_map(|(mut cases, names)| {
-            cases.sort_by_key(|c| names.iter().position(|m| *m == c.method));
-            cases
-        })
-        .collect())
+    done.sort_by_key(|(i, _)| *i);
+    done.into_iter().map(|(_, t)| t).collect()
 }
 
 /// What the jobs of [`run_plan`] share: each scenario's rest geometry and reference case, computed
@@ -381,8 +413,7 @@ impl SharedCases<'_> {
             rest,
             method,
             stderr_log,
-            self.options.threads,
-            self.options.repetitions,
+            CaseSettings { threads: self.options.threads, measure_memory: self.options.jobs == 1 },
             &self.config.rules,
             reference,
         )

@@ -191,6 +191,26 @@ impl Status {
 
     /// The status of a case that produced a shape: `Unfinished` when any step did not finish (its
     /// reasons first, then the shape's), else `Suspect` for any shape reason, else `Ok`.
+    /// Add suspect `reasons` found after the verdict (a later repetition's): an `ok` case turns
+    /// suspect; an unfinished one keeps its kind; a failed one stays failed.
+    pub fn add_reasons(&mut self, reasons: Vec<String>) {
+        if reasons.is_empty() {
+            return;
+        }
+        *self = match std::mem::replace(self, Status::Ok) {
+            Status::Ok => Status::Suspect(reasons),
+            Status::Suspect(mut r) => {
+                r.extend(reasons);
+                Status::Suspect(r)
+            }
+            Status::Unfinished(mut r) => {
+                r.extend(reasons);
+                Status::Unfinished(r)
+            }
+            failed @ Status::Failed(_) => failed,
+        };
+    }
+
     pub fn judge(unfinished: &[Unfinished], reasons: Vec<String>) -> Status {
         if !unfinished.is_empty() {
             let mut all: Vec<String> = unfinished.iter().map(ToString::to_string).collect();

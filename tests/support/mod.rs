@@ -131,6 +131,7 @@ pub fn timeless(case: &serde_json::Value) -> serde_json::Value {
         "median_iteration_ms",
         "solve_s",
         "total_s",
+        "peak_memory_mib",
         "phase_timings",
         "overhead",
         "spread",

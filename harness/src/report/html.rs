@@ -122,7 +122,7 @@ pub fn render_index(
         "<h2 id=\"results\">Results</h2>\n<div class=\"scroll\"><table>\n<tr><th>scenario</th><th>method</th>\
          <th>status</th><th>#V</th>\
          <th>iterations</th><th>converged</th><th title=\"an external method's process start-up, not part of precompute\">startup</th><th>precompute</th><th>bind</th><th>solve</th><th>total</th>\
-         <th>iteration (ms)</th>",
+         <th>iteration (ms)</th><th title=\"what the method added to the resident memory at its peak (one case at a time only)\">peak memory (MiB)</th>",
     );
     for spec in &METRICS {
         let _ = write!(page, "<th title=\"{}\">{}</th>", escape(spec.doc), escape(spec.label));
@@ -143,7 +143,7 @@ pub fn render_index(
         let _ = write!(
             page,
             "<tr class=\"{class}\"><td class=\"text\">{}</td><td class=\"text\">{}{badge}</td><td class=\"text status\">{}</td>\
-             <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>",
+             <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>",
             escape(&r.scenario),
             escape(&r.method),
             escape(&r.status.to_string()),
@@ -156,6 +156,7 @@ pub fn render_index(
             timing(r.solve_s, r.spread.map(|s| (s.repetitions, s.solve_s)), 3),
             timing(r.total_s, r.spread.map(|s| (s.repetitions, s.total_s)), 3),
             timing(r.median_iteration_ms, r.spread.map(|s| (s.repetitions, s.median_iteration_ms)), 3),
+            number(r.peak_memory_mib, 0),
         );
         for spec in &METRICS {
             let _ = write!(page, "<td>{}</td>", escape(&spec.format.apply(r.quality.get(spec.metric))));

@@ -44,6 +44,7 @@ const CASE_COLUMNS: &[&str] = &[
     "median_iteration_ms_max",
     "startup_s_min",
     "startup_s_max",
+    "peak_memory_mib",
 ];
 
 /// The CSV columns after the metrics.
@@ -152,6 +153,7 @@ pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
             let (min, max) = if r.spread.is_some() { (s.min, s.max) } else { (f64::NAN, f64::NAN) };
             row.extend([num(min), num(max)]);
         }
+        row.push(num(r.peak_memory_mib));
         row.extend(METRICS.iter().map(|s| r.quality.get(s.metric).map(num).unwrap_or_default()));
         row.extend([
             num(r.largest_move_over_diag),
