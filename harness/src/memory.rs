@@ -4,7 +4,10 @@
 //! added at its peak: its factorizations, eigenvectors and reduced model, not the meshes the harness
 //! already holds. Only meaningful when one case runs at a time (`--jobs 1`: the counter is the
 //! process's) and for methods that run in the process (an external method's memory is its own
-//! process's). Anything unreadable gives `None`, never an error.
+//! process's). It is a lower bound: pages the allocator kept from earlier cases and reuses are
+//! already resident, so a small case often reads 0; the large blocks of a large mesh (factors,
+//! eigenvector bases) are mapped afresh and do count. A counting global allocator would be exact,
+//! at a cost on every allocation. Anything unreadable gives `None`, never an error.
 
 /// The resident set now, bytes, with the high-water mark reset to it; `None` where Linux's
 /// counters are not there.
