@@ -597,10 +597,10 @@ fn configs_with(scenarios: &[(String, String)]) -> tempfile::TempDir {
     configs
 }
 
-#[test]
-fn shards_merged_equal_one_run_to_the_last_digit() {
-    // Three small look-alikes of different cost, so the cost balance puts them on different shards.
-    let scenarios: Vec<(String, String)> = [("bar", 2400), ("cylinder", 1200), ("cactus", 1600)]
+/// Scenario files `(file name, contents)` of procedural `(shape, vertices)` running laplacian, arap
+/// (the reference) and isolines.
+fn small_procedural(shapes: &[(&str, usize)]) -> Vec<(String, String)> {
+    shapes
         .iter()
         .map(|(shape, n)| {
             (
@@ -611,8 +611,13 @@ fn shards_merged_equal_one_run_to_the_last_digit() {
                 ),
             )
         })
-        .collect();
-    let configs = configs_with(&scenarios);
+        .collect()
+}
+
+#[test]
+fn shards_merged_equal_one_run_to_the_last_digit() {
+    // Three small look-alikes of different cost, so the cost balance puts them on different shards.
+    let configs = configs_with(&small_procedural(&[("bar", 2400), ("cylinder", 1200), ("cactus", 1600)]));
     let configs = configs.path().to_str().unwrap();
     let work = tempfile::tempdir().unwrap();
     let dir = |name: &str| work.path().join(name).to_str().unwrap().to_string();
@@ -692,19 +697,7 @@ fn shards_merged_equal_one_run_to_the_last_digit() {
 fn jobs_run_cases_at_once_and_report_what_one_job_does() {
     // Two scenarios with the reference and two others each: with 2 jobs, a scenario's other cases
     // wait for (or run) its reference, and the report comes back in plan order.
-    let scenarios: Vec<(String, String)> = [("bar", 1800), ("cactus", 1200)]
-        .iter()
-        .map(|(shape, n)| {
-            (
-                format!("{shape}.toml"),
-                format!(
-                    "name = \"{shape}\"\nprocedural = {{ shape = \"{shape}\", vertices = {n} }}\n\
-                     methods = [\"laplacian\", \"arap\", \"isolines\"]\n"
-                ),
-            )
-        })
-        .collect();
-    let configs = configs_with(&scenarios);
+    let configs = configs_with(&small_procedural(&[("bar", 1800), ("cactus", 1200)]));
     let configs = configs.path().to_str().unwrap();
     let work = tempfile::tempdir().unwrap();
     let dir = |name: &str| work.path().join(name).to_str().unwrap().to_string();

@@ -318,10 +318,7 @@ pub(crate) fn repetition(
         solve_s += t.elapsed().as_secs_f64();
     }
     let total_s = start.elapsed().as_secs_f64();
-    // The first repetition's median is the upper middle of an even count (median_ms): the same here.
-    let mut seconds = clock.0;
-    seconds.sort_by(f64::total_cmp);
-    let median_iteration_ms = seconds.get(seconds.len() / 2).map_or(f64::NAN, |t| 1e3 * t);
+    let median_iteration_ms = median_of_seconds_ms(clock.0);
     Ok((
         Timings { startup_s, precompute_s, bind_s: first_bind_s, median_iteration_ms, solve_s, total_s },
         m.positions(),
@@ -650,7 +647,12 @@ impl CaseResult {
 
 /// Median iteration time in milliseconds (NaN for none).
 fn median_ms(trace: &[IterationRecord]) -> f64 {
-    let mut times: Vec<f64> = trace.iter().map(|r| r.seconds).collect();
+    median_of_seconds_ms(trace.iter().map(|r| r.seconds).collect())
+}
+
+/// The median of iteration `times` (seconds; the upper middle of an even count) in milliseconds;
+/// NaN for none. The first round ([`median_ms`]) and the later ones ([`repetition`]) share it.
+fn median_of_seconds_ms(mut times: Vec<f64>) -> f64 {
     times.sort_by(f64::total_cmp);
     times.get(times.len() / 2).map_or(f64::NAN, |t| 1e3 * t)
 }

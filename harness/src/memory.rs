@@ -23,11 +23,6 @@ pub fn peak_since(start: Option<u64>) -> Option<f64> {
     Some(peak.saturating_sub(start) as f64 / (1024.0 * 1024.0))
 }
 
-/// The process's whole peak resident set, MiB (for the run's record).
-pub fn process_peak_mib() -> Option<f64> {
-    status_kib("VmHWM").map(|k| k as f64 / 1024.0)
-}
-
 /// A `kB` field of /proc/self/status.
 fn status_kib(field: &str) -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;

@@ -136,7 +136,7 @@ impl Machine {
             .unwrap_or_else(|_| UNKNOWN.into());
         Machine {
             cpu_model,
-            logical_cores: crate::threads::default_threads(1),
+            logical_cores: crate::threads::logical_cores(),
             memory_gib: memory_kib / (1024.0 * 1024.0),
             os,
             kernel,

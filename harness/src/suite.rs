@@ -191,8 +191,7 @@ fn plan(options: &SuiteOptions, catalog: &MethodCatalog, scenarios: &[LoadedScen
 /// Run every selected method on every scenario. [`REFERENCE_METHOD`] runs first in each scenario so
 /// the others can be compared with it; results are reported in registry order.
 pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
-    let mut provenance =
-        Provenance::record(options.command_line.clone(), options.threads, options.jobs, options.repetitions);
+    let mut provenance = record_of(options);
     let (config, scenarios, source) = prepare(options)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let plan = plan(options, &config.catalog, &scenarios);
@@ -204,8 +203,7 @@ pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
 
 /// Run the scenarios of part `shard` of the suite ([`crate::shard::assign`] on their estimated cost).
 pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, HarnessError> {
-    let mut provenance =
-        Provenance::record(options.command_line.clone(), options.threads, options.jobs, options.repetitions);
+    let mut provenance = record_of(options);
     let (config, scenarios, source) = prepare(options)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let data_source = describe_data(&source, &scenarios);
@@ -227,6 +225,11 @@ pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, Harne
     let results = run_plan(options, &config, &scenarios, &plan)?;
     provenance.external = crate::provenance::external_records(&results);
     Ok(SuiteRun { notes: notes_of(options, &scenarios), results, scenarios, data_source, provenance })
+}
+
+/// The record of a run started now with `options`.
+fn record_of(options: &SuiteOptions) -> Provenance {
+    Provenance::record(options.command_line.clone(), options.threads, options.jobs, options.repetitions)
 }
 
 /// Every file the run read: the configuration, each scenario file and what it named.
@@ -425,8 +428,7 @@ impl SharedCases<'_> {
 /// from its mesh file. Errors: a missing or repeated part, parts of different runs (data source or
 /// N), a case of a scenario the options do not load, a mesh that does not fit its scenario.
 pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, HarnessError> {
-    let mut provenance =
-        Provenance::record(options.command_line.clone(), options.threads, options.jobs, options.repetitions);
+    let mut provenance = record_of(options);
     let (config, scenarios, source) = prepare(options)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let data_source = describe_data(&source, &scenarios);

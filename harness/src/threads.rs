@@ -17,9 +17,14 @@ pub const JOB_NAME: &str = "deformbench-job";
 pub const THREAD_VARIABLES: [&str; 4] =
     ["OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "IGL_NUM_THREADS"];
 
+/// The machine's logical cores (1 when unknown).
+pub fn logical_cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
 /// The logical cores of the machine shared among `jobs` concurrent cases, at least 1 each.
 pub fn default_threads(jobs: usize) -> usize {
-    (std::thread::available_parallelism().map_or(1, |n| n.get()) / jobs.max(1)).max(1)
+    (logical_cores() / jobs.max(1)).max(1)
 }
 
 /// A pool of `threads` named workers.
