@@ -76,11 +76,12 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
                 assert!(v.is_finite() && v >= 0.0, "{scenario}/{method}: {key} = {v}");
             }
             // GLB by default; OFF only with `--mesh-format off|both`.
-            let glb = reports.path().join(format!("meshes/{scenario}-{method}.glb"));
+            let stem = harness::report::case_file_stem(scenario, method);
+            let glb = reports.path().join(format!("meshes/{stem}.glb"));
             let result = meshes::io::read_mesh(&glb).unwrap();
             assert_eq!(result.n_vertices(), row["vertices"].parse::<usize>().unwrap());
             assert_eq!(result.n_faces(), row["faces"].parse::<usize>().unwrap());
-            assert!(!reports.path().join(format!("meshes/{scenario}-{method}.off")).exists());
+            assert!(!reports.path().join(format!("meshes/{stem}.off")).exists());
         }
         let arap = rows.iter().find(|r| r["scenario"] == scenario && r["method"] == "arap").unwrap();
         assert_eq!(support::num(arap, "rms_to_arap_over_diag"), 0.0);
@@ -130,7 +131,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
     // 1.2% farther from it (RMS 0.0453 vs 0.0447 of the diagonal; with cotan weights 20 were nearer).
     let bar = |method: &str| rows.iter().find(|r| r["scenario"] == "bar" && r["method"] == method).unwrap();
     let (fine, coarse) =
-        (support::num(bar("isolines"), "e_phi_deg"), support::num(bar("isolines_10"), "e_phi_deg"));
+        (support::num(bar("isolines"), "e_phi_deg"), support::num(bar("isolines[isolines=10]"), "e_phi_deg"));
     assert!(fine <= coarse, "bar: e_phi_deg with 20 isolines {fine} > with 10 {coarse}");
     // The standard suite ends with the regression gate (the exit code above says it passed) and
     // a page with every plot and figure.
@@ -1176,5 +1177,68 @@ fn a_case_stopped_at_its_cap_is_unfinished_and_the_gate_sees_it() {
     assert_eq!(
         run(&["check", "--reports", &second, "--baseline", &baseline]).unwrap(),
         std::process::ExitCode::from(harness::cli::EXIT_REGRESSION)
+    );
+}
+
+#[test]
+fn sweeps_add_points_named_by_their_values_and_a_budget_table_that_picks_the_best_ok_one() {
+    // No `methods` list: every method runs on it, and the sweep points where sweeps.toml says.
+    let configs = configs_with(&[(
+        "bar.toml".to_string(),
+        "name = \"bar\"\nprocedural = { shape = \"bar\", vertices = 800 }\n".to_string(),
+    )]);
+    std::fs::write(
+        configs.path().join("sweeps.toml"),
+        "scenarios = [\"bar\"]\n[per_field]\nmethod = \"isolines\"\nparams = { isolines = [5, 10, 20] }\n\
+         [arap_tolerance]\nmethod = \"arap\"\nparams = { tolerance = [1e-3, 1e-5] }\n",
+    )
+    .unwrap();
+    let reports = tempfile::tempdir().unwrap();
+    let configs = configs.path().to_str().unwrap();
+    let out = reports.path().to_str().unwrap();
+    let args = ["all", "--quiet", "--sweeps", "--configs", configs, "--reports", out, "--no-check"];
+    assert_eq!(run(&args).unwrap(), std::process::ExitCode::SUCCESS);
+
+    let rows = support::csv_rows(&reports.path().join("results.csv"));
+    let names: Vec<&str> = rows.iter().map(|r| r["method"].as_str()).collect();
+    for point in ["isolines[isolines=5]", "isolines[isolines=10]", "arap[tolerance=1e-3]"] {
+        assert!(names.contains(&point), "{point} missing from {names:?}");
+    }
+    // The points equal to their base's table are the base methods, not run twice.
+    assert!(
+        !names.iter().any(|n| *n == "isolines[isolines=20]" || *n == "arap[tolerance=1e-5]"),
+        "{names:?}"
+    );
+    let json = read_json(&reports.path().join("results.json"));
+    let isolines = json["cases"].as_array().unwrap().iter().find(|c| c["method"] == "isolines").unwrap();
+    assert_eq!(isolines["sweeps"][0]["sweep"], "per_field");
+    assert_eq!(isolines["sweeps"][0]["position"], 2);
+    // A point runs with its values: its model has fewer isolines than the base's 20 per field.
+    let case =
+        |name: &str| json["cases"].as_array().unwrap().iter().find(|c| c["method"] == name).unwrap().clone();
+    let isolines_of = |c: &serde_json::Value| {
+        let stats = c["statistics"].as_array().unwrap();
+        let n = stats.iter().find(|s| s[0] == methods::keys::statistic::N_ISOLINES).expect("n_isolines");
+        n[1].as_f64().unwrap()
+    };
+    let (coarse, base) = (isolines_of(&case("isolines[isolines=5]")), isolines_of(&case("isolines")));
+    assert!(coarse > 0.0 && coarse < base, "n_isolines: {coarse} with 5 per field, {base} with 20");
+
+    assert!(reports.path().join("plots/bar-pareto.png").is_file());
+    let page = std::fs::read_to_string(reports.path().join("index.html")).unwrap();
+    assert!(page.contains("id=\"quality-time\"") && page.contains("plots/bar-pareto.png"));
+    // The 10 s row of the budget table names the ok case with the lowest E_theta within 10 s per edit.
+    let pareto = std::fs::read_to_string(reports.path().join("pareto.md")).unwrap();
+    let row = pareto.lines().find(|l| l.starts_with("| 10 s |")).expect("a 10 s row");
+    let best = rows
+        .iter()
+        .filter(|r| r["status"] == "ok" && support::num(r, "bind_s") + support::num(r, "solve_s") <= 10.0)
+        .min_by(|a, b| support::num(a, "e_theta_deg").total_cmp(&support::num(b, "e_theta_deg")))
+        .unwrap();
+    let cell = row.split('|').nth(2).unwrap().trim();
+    assert!(
+        cell.starts_with(&format!("{}:", best["method"])),
+        "10 s row `{cell}`, best ok {}",
+        best["method"]
     );
 }

@@ -38,4 +38,4 @@ class LibiglBiharmonic:
 
 if __name__ == "__main__":
     version = importlib.metadata.version("libigl")
-    protocol.serve(LibiglBiharmonic, about=f"libigl {version} harmonic, k = 2 on the handle displacements")
+    protocol.serve(LibiglBiharmonic, about=f"libigl {version} k-harmonic (params k, default 2) on the handle displacements")

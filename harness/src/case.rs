@@ -92,6 +92,9 @@ pub struct CaseResult {
     /// The Laplacian weights the method ran with (`weights` in configs/methods.toml).
     #[serde(default)]
     pub laplacian_weights: String,
+    /// The parameter sweeps the method is a point of ([`crate::sweep`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sweeps: Vec<crate::sweep::SweepPosition>,
     /// An external method's process start-up and handshake (NaN for a built-in method): not part of
     /// `precompute_s`.
     #[serde(default = "nan", deserialize_with = "nan_from_null")]
@@ -415,6 +418,7 @@ pub fn run_case(
         scenario.mesh.n_faces(),
     );
     result.origin = method.origin;
+    result.sweeps = method.sweeps.clone();
     result.laplacian_weights = match method.origin {
         Origin::BuiltIn => laplacian_weights(params),
         Origin::External | Origin::Peer => String::new(),
@@ -615,6 +619,7 @@ impl CaseResult {
             vertices,
             faces,
             laplacian_weights: String::new(),
+            sweeps: Vec::new(),
             startup_s: f64::NAN,
             precompute_s: f64::NAN,
             bind_s: f64::NAN,

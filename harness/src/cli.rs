@@ -63,6 +63,9 @@ enum Command {
         meshes: Meshes,
         #[command(flatten)]
         gate: Gate,
+        /// The parts ran with --sweeps: report the sweep points in the order one run would.
+        #[arg(long)]
+        sweeps: bool,
     },
     /// Run chosen methods on one scenario and print the results (writes reports/ like `all`).
     Run {
@@ -137,6 +140,11 @@ struct Peers {
     /// meshes: ~25 s per result on the bumpy plane) and report it in the `self_intersecting` column.
     #[arg(long)]
     self_intersections: bool,
+    /// Add the parameter sweeps of configs/sweeps.toml (each value of a swept parameter one more
+    /// variant, `isolines[isolines=10]`) on the scenarios it names, and draw each test's
+    /// quality–time plots and budget table (README "Sweeps").
+    #[arg(long)]
+    sweeps: bool,
     /// The cross-check Python with libigl and open3d (`scripts/python-env` prints it).
     #[arg(long, env = peers::PYTHON_ENV)]
     python: Option<PathBuf>,
@@ -251,6 +259,7 @@ impl Common {
             scenarios,
             methods,
             peers: None,
+            sweeps: None,
             threads: self
                 .threads
                 .map_or_else(|| crate::threads::default_threads(self.jobs as usize), |t| t as usize),
@@ -286,6 +295,7 @@ where
         Command::All { common, peers, meshes, gate, no_check, shard } => {
             let mut options = common.options(Vec::new(), Vec::new(), &command_line);
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
+            options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
             if let Some(shard) = shard {
                 return run_shard(&options, shard);
             }
@@ -299,8 +309,9 @@ where
             run.notes.extend(skipped_peers);
             publish_and_print(&options, run, &publish, gate)
         }
-        Command::Merge { partials, common, meshes, gate } => {
-            let options = common.options(Vec::new(), Vec::new(), &command_line);
+        Command::Merge { partials, common, meshes, gate, sweeps } => {
+            let mut options = common.options(Vec::new(), Vec::new(), &command_line);
+            options.sweeps = sweeps.then(|| options.configs_dir.join("sweeps.toml"));
             let run = suite::merge(&options, &partials).context("merging partial reports")?;
             let gate = GateRequest::for_suite(&options, gate.baseline);
             let publish = PublishOptions { peer_python: None, meshes: meshes.output() };
@@ -309,6 +320,7 @@ where
         Command::Run { methods, scenario, common, peers, meshes } => {
             let mut options = common.options(vec![scenario], methods, &command_line);
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
+            options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
             let publish = PublishOptions { peer_python: peers.python()?, meshes: meshes.output() };
             let mut run = suite::run(&options).context("preparing the run")?;
             run.notes.extend(skipped_peers);

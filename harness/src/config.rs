@@ -1,7 +1,10 @@
 //! The methods of a run, as configured: `configs/methods.toml` holds a table per method, either the
 //! parameters of a built-in method (missing keys take the papers' defaults), a variant of one
-//! (`method` and its `params`), or an external program (`command`, see [`ExternalEntry`]); `configs/peers.toml`, in the same format, holds the peer
-//! libraries' adapters that `--peers` adds. Unknown names and keys are errors that name the file.
+//! (`method` and its `params`, laid over the base method's table), or an external program
+//! (`command`, see [`ExternalEntry`]); `configs/peers.toml`, in the same format, holds the peer
+//! libraries' adapters that `--peers` adds, and `configs/sweeps.toml` the parameter sweeps that
+//! `--sweeps` adds. A variant whose `params` hold lists is a sweep ([`crate::sweep`]): one variant
+//! per value. Unknown names and keys are errors that name the file.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -9,6 +12,7 @@ use std::time::Duration;
 use serde::{Deserialize, Serialize};
 
 use crate::error::HarnessError;
+use crate::sweep::{self, SweepPosition};
 use methods::external::{ExternalMethod, ExternalSpec};
 use methods::{DeformationMethod, MethodError};
 
@@ -92,6 +96,11 @@ pub struct ConfiguredMethod {
     pub implementation: Implementation,
     /// One line: what it is (`list`).
     pub summary: String,
+    /// The sweeps it is a point of (a base method is one where a sweep sets its own values).
+    pub sweeps: Vec<SweepPosition>,
+    /// The scenarios it runs on unless a scenario names it (`None`: every scenario that does not
+    /// restrict its methods); a sweep file's `scenarios`.
+    pub runs_on: Option<Vec<String>>,
 }
 
 impl ConfiguredMethod {
@@ -144,25 +153,64 @@ impl MethodCatalog {
                 params: toml::Table::new(),
                 implementation: Implementation::BuiltIn(m),
                 summary: m.summary.to_string(),
+                sweeps: Vec::new(),
+                runs_on: None,
             })
             .collect();
-        for (name, table) in read_tables(path)? {
+        let tables = read_tables(path)?;
+        let is_entry = |t: &toml::Table| t.contains_key("command") || t.contains_key("method");
+        // The built-in methods' own tables first: variants lay their params over them.
+        for (name, table) in tables.iter().filter(|(_, t)| !is_entry(t)) {
             let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
-            if table.contains_key("command") || table.contains_key("method") {
-                if methods.iter().any(|m| m.name == name) {
-                    return Err(config(format!(
-                        "`{name}` is a built-in method; a new entry needs another name"
-                    )));
-                }
-                methods.push(entry(path, &name, &table, Origin::External, &[])?);
-            } else {
-                // Building the method validates the name and every key.
-                methods::registry::create(&name, &table).map_err(|e| config(e.to_string()))?;
-                let entry = methods.iter_mut().find(|m| m.name == name).expect("a registered method");
-                entry.params = table;
-            }
+            // Building the method validates the name and every key.
+            methods::registry::create(name, table).map_err(|e| config(e.to_string()))?;
+            let entry = methods.iter_mut().find(|m| &m.name == name).expect("a registered method");
+            entry.params = table.clone();
         }
-        Ok(Self { path: path.to_path_buf(), methods })
+        let mut catalog = Self { path: path.to_path_buf(), methods };
+        for (name, table) in tables.iter().filter(|(_, t)| is_entry(t)) {
+            if catalog.methods.iter().any(|m| &m.name == name) {
+                return Err(HarnessError::Config {
+                    path: path.to_path_buf(),
+                    message: format!("`{name}` is a built-in method; a new entry needs another name"),
+                });
+            }
+            catalog.add_entry(path, name, table, Origin::External, &[], None)?;
+        }
+        Ok(catalog)
+    }
+
+    /// Add the sweeps of `path` (`configs/sweeps.toml`, `--sweeps`): variants with list-valued
+    /// `params`, run on the scenarios its top-level `scenarios` list names (default: every one that
+    /// does not restrict its methods).
+    pub fn add_sweeps(&mut self, path: &Path) -> Result<(), HarnessError> {
+        let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
+        let text = std::fs::read_to_string(path)
+            .map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
+        let mut top: toml::Table = text.parse().map_err(|e: toml::de::Error| config(e.to_string()))?;
+        let scenarios = match top.remove("scenarios") {
+            None => None,
+            Some(toml::Value::Array(list)) => Some(
+                list.iter()
+                    .map(|v| v.as_str().map(str::to_string))
+                    .collect::<Option<Vec<String>>>()
+                    .ok_or_else(|| config("`scenarios` must be a list of scenario names".into()))?,
+            ),
+            Some(_) => return Err(config("`scenarios` must be a list of scenario names".into())),
+        };
+        let peers = std::fs::read_to_string(path.with_file_name("peers.toml")).unwrap_or_default();
+        for (name, table) in tables_in_file_order(&text, top).map_err(config)? {
+            let Some(base) = table.get("method").and_then(toml::Value::as_str) else {
+                return Err(config(format!("[{name}]: a sweep names its base method: method = \"…\"")));
+            };
+            if self.get(base).is_none() && peers.contains(&format!("[{base}]")) {
+                // A peer's knob: swept when the run has the peers.
+                eprintln!("note: sweep [{name}] of the peer `{base}` not run (add --peers)");
+                continue;
+            }
+            self.add_entry(path, &name, &table, Origin::BuiltIn, &[], scenarios.as_deref())?;
+        }
+        Ok(())
     }
 
     /// Add the external methods of `peers.file` (`configs/peers.toml`) as peers, with
@@ -178,7 +226,105 @@ impl MethodCatalog {
                     message: format!("peer `{name}` has the name of a method of {}", self.path.display()),
                 });
             }
-            self.methods.push(entry(path, &name, &table, Origin::Peer, &given)?);
+            self.add_entry(path, &name, &table, Origin::Peer, &given, None)?;
+        }
+        Ok(())
+    }
+
+    /// Add the entry `name` of `path`: a variant (one method, or a sweep's points) or an external
+    /// method of `origin`.
+    fn add_entry(
+        &mut self,
+        path: &Path,
+        name: &str,
+        table: &toml::Table,
+        origin: Origin,
+        given: &[(&str, &str)],
+        runs_on: Option<&[String]>,
+    ) -> Result<(), HarnessError> {
+        let config = |message: String| HarnessError::Config {
+            path: path.to_path_buf(),
+            message: format!("[{name}]: {message}"),
+        };
+        let base_name = table.get("method").and_then(toml::Value::as_str);
+        let params = match table.get("params") {
+            Some(toml::Value::Table(t)) => t.clone(),
+            _ => toml::Table::new(),
+        };
+        let Some(base_name) = base_name.filter(|_| sweep::is_sweep(&params)) else {
+            let mut method = entry(path, name, table, origin, given, self)?;
+            method.runs_on = runs_on.map(<[String]>::to_vec);
+            self.methods.push(method);
+            return Ok(());
+        };
+        // A sweep: one variant per point, named by its values (the swept ones, then the ones every
+        // point shares), laid over the base method's table.
+        // The base is a method of its own: a built-in one, or an external program or peer (whose
+        // points send it other `params`); not a variant.
+        let base = self
+            .get(base_name)
+            .filter(|m| match &m.implementation {
+                Implementation::BuiltIn(e) => e.name == m.name,
+                Implementation::External(_) => !m.name.contains('['),
+            })
+            .ok_or_else(|| {
+                config(format!(
+                    "`method = \"{base_name}\"`: a sweep varies a built-in, external or peer method (known: {})",
+                    self.names().filter(|n| !n.contains('[')).collect::<Vec<_>>().join(", ")
+                ))
+            })?
+            .clone();
+        let (points, shared) = sweep::expand(&params).map_err(config)?;
+        // A sweep of the same name declared again (sweeps.toml extending methods.toml's) replaces
+        // the earlier one's line.
+        for m in &mut self.methods {
+            m.sweeps.retain(|p| p.sweep != name);
+        }
+        for (position, point) in points.iter().enumerate() {
+            let params = point.apply(&base.params);
+            let params = sweep::Point { values: shared.clone().into_iter().collect() }.apply(&params);
+            let here = SweepPosition { sweep: name.to_string(), position, values: point.values_text() };
+            if params == base.params {
+                self.methods.iter_mut().find(|m| m.name == base.name).expect("the base").sweeps.push(here);
+                continue;
+            }
+            let mut named = point.clone();
+            named.values.extend(shared.clone());
+            let point_name = named.name(&base.name);
+            if let Some(existing) = self.methods.iter_mut().find(|m| m.name == point_name) {
+                if existing.params != params {
+                    return Err(config(format!(
+                        "`{point_name}` is configured twice with different parameters"
+                    )));
+                }
+                existing.sweeps.push(here);
+                continue;
+            }
+            let implementation = match &base.implementation {
+                Implementation::BuiltIn(builtin) => {
+                    methods::registry::create(builtin.name, &params)
+                        .map_err(|e| config(format!("{point_name}: {e}")))?;
+                    Implementation::BuiltIn(builtin)
+                }
+                // An external program checks its own parameters when it starts.
+                Implementation::External(e) => Implementation::External(ExternalEntry {
+                    params: serde_json::to_value(&params)
+                        .map_err(|e| config(format!("{point_name}: {e}")))?,
+                    ..e.clone()
+                }),
+            };
+            self.methods.push(ConfiguredMethod {
+                name: point_name,
+                origin: base.origin,
+                params,
+                implementation,
+                summary: match table.get("summary").and_then(toml::Value::as_str) {
+                    Some(s) => format!("{s}: {}", named.values_text()),
+                    None => format!("`{}` with {}", base.name, named.values_text()),
+                },
+                sweeps: vec![here],
+                runs_on: runs_on.map(<[String]>::to_vec),
+            });
         }
         Ok(())
     }
@@ -214,17 +360,17 @@ impl MethodCatalog {
 fn read_tables(path: &Path) -> Result<Vec<(String, toml::Table)>, HarnessError> {
     let text = std::fs::read_to_string(path)
         .map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
-    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| HarnessError::Config {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })?;
+    let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
+    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| config(e.to_string()))?;
+    tables_in_file_order(&text, table).map_err(config)
+}
+
+/// The top-level tables of `table`, parsed from `text`, in file order.
+fn tables_in_file_order(text: &str, table: toml::Table) -> Result<Vec<(String, toml::Table)>, String> {
     let mut tables = Vec::new();
     for (name, value) in table {
         let toml::Value::Table(params) = value else {
-            return Err(HarnessError::Config {
-                path: path.to_path_buf(),
-                message: format!("`{name}` must be a table of parameters, e.g. [{name}]"),
-            });
+            return Err(format!("`{name}` must be a table of parameters, e.g. [{name}]"));
         };
         tables.push((name, params));
     }
@@ -241,6 +387,7 @@ fn entry(
     table: &toml::Table,
     origin: Origin,
     given: &[(&str, &str)],
+    catalog: &MethodCatalog,
 ) -> Result<ConfiguredMethod, HarnessError> {
     let config = |message: String| HarnessError::Config {
         path: path.to_path_buf(),
@@ -270,14 +417,24 @@ fn entry(
         }
         let base = base.as_str().ok_or_else(|| config("`method` must be a method name".into()))?;
         let builtin = methods::registry::find(base).map_err(|e| config(e.to_string()))?;
+        let summary = summary.unwrap_or_else(|| format!("`{base}` with {params}").replace('\n', ", "));
+        // The base method as configured, with the variant's own values.
+        let params = match catalog.get(base) {
+            Some(configured) => {
+                sweep::Point { values: params.into_iter().collect() }.apply(&configured.params)
+            }
+            None => params,
+        };
         methods::registry::create(base, &params).map_err(|e| config(e.to_string()))?;
         return Ok(ConfiguredMethod {
             name: name.to_string(),
             // Our own implementation, whichever file named it.
             origin: Origin::BuiltIn,
-            summary: summary.unwrap_or_else(|| format!("`{base}` with {params}").replace('\n', ", ")),
+            summary,
             params,
             implementation: Implementation::BuiltIn(builtin),
+            sweeps: Vec::new(),
+            runs_on: None,
         });
     }
     if let Some(key) = table.keys().find(|k| !EXTERNAL_KEYS.contains(&k.as_str())) {
@@ -335,6 +492,8 @@ fn entry(
         origin,
         params,
         summary,
+        sweeps: Vec::new(),
+        runs_on: None,
         implementation: Implementation::External(ExternalEntry {
             program: command.next().expect("non-empty"),
             args: command.collect(),
@@ -407,5 +566,75 @@ mod tests {
         assert_eq!(variant.origin, Origin::BuiltIn);
         assert_eq!(variant.params.get("weights").and_then(|v| v.as_str()), Some("cotan"));
         assert!(catalog.get("arap").unwrap().params.is_empty(), "the base keeps its own parameters");
+    }
+
+    #[test]
+    fn a_sweep_is_one_named_variant_per_value_laid_over_the_base_table() {
+        let catalog = load(
+            "[isolines]\nisolines = 20\nbeta = 0.02\n\
+             [per_field]\nmethod = \"isolines\"\nparams = { isolines = [5, 20, 40] }\n\
+             [fields]\nmethod = \"hirm\"\nparams = { min_fields = [6, 12], threshold = 1.001 }\n",
+        )
+        .unwrap();
+        let builtin = methods::registry::METHODS.len();
+        let names: Vec<&str> = catalog.names().skip(builtin).collect();
+        // isolines = 20 is [isolines] itself: not a method of its own.
+        assert_eq!(
+            names,
+            [
+                "isolines[isolines=5]",
+                "isolines[isolines=40]",
+                "hirm[min_fields=6,threshold=1.001]",
+                "hirm[min_fields=12,threshold=1.001]"
+            ]
+        );
+        let five = catalog.get("isolines[isolines=5]").unwrap();
+        assert_eq!(five.params, "isolines = 5\nbeta = 0.02".parse::<toml::Table>().unwrap());
+        assert!(matches!(five.implementation, Implementation::BuiltIn(e) if e.name == "isolines"));
+        let at = |m: &ConfiguredMethod| -> Vec<(String, usize, String)> {
+            m.sweeps.iter().map(|p| (p.sweep.clone(), p.position, p.values.clone())).collect()
+        };
+        assert_eq!(at(five), [("per_field".to_string(), 0, "isolines=5".to_string())]);
+        assert_eq!(
+            at(catalog.get("isolines").unwrap()),
+            [("per_field".to_string(), 1, "isolines=20".to_string())]
+        );
+        assert_eq!(
+            at(catalog.get("hirm[min_fields=12,threshold=1.001]").unwrap()),
+            [("fields".to_string(), 1, "min_fields=12".to_string())]
+        );
+        let err = load("[s]\nmethod = \"isolines\"\nparams = { isolines = [] }\n").unwrap_err();
+        assert!(err.contains("[s]") && err.contains("`isolines`"), "{err}");
+        let err = load("[s]\nmethod = \"isolines\"\nparams = { isolines = [1] }\n").unwrap_err();
+        assert!(err.contains("isolines[isolines=1]"), "{err}");
+    }
+
+    #[test]
+    fn a_sweep_file_adds_points_where_it_says_and_shares_the_existing_ones() {
+        let dir = tempfile::tempdir().unwrap();
+        let methods = dir.path().join("methods.toml");
+        std::fs::write(&methods, "[few]\nmethod = \"isolines\"\nparams = { isolines = [10] }\n").unwrap();
+        let sweeps = dir.path().join("sweeps.toml");
+        std::fs::write(
+            &sweeps,
+            "scenarios = [\"bar\"]\n[per_field]\nmethod = \"isolines\"\nparams = { isolines = [10, 30] }\n",
+        )
+        .unwrap();
+        let mut catalog = MethodCatalog::load(&methods).unwrap();
+        catalog.add_sweeps(&sweeps).unwrap();
+        let ten = catalog.get("isolines[isolines=10]").unwrap();
+        assert_eq!(ten.runs_on, None, "methods.toml's point runs everywhere");
+        assert_eq!(ten.sweeps.iter().map(|p| p.sweep.as_str()).collect::<Vec<_>>(), ["few", "per_field"]);
+        // A sweep of the same name again is one line, the later one's.
+        std::fs::write(&sweeps, "[few]\nmethod = \"isolines\"\nparams = { isolines = [30, 10] }\n").unwrap();
+        catalog.add_sweeps(&sweeps).unwrap();
+        let ten = catalog.get("isolines[isolines=10]").unwrap();
+        let few: Vec<usize> = ten.sweeps.iter().filter(|p| p.sweep == "few").map(|p| p.position).collect();
+        assert_eq!(few, [1]);
+        let thirty = catalog.get("isolines[isolines=30]").unwrap();
+        assert_eq!(thirty.runs_on, Some(vec!["bar".to_string()]));
+        std::fs::write(&sweeps, "[x]\ncommand = [\"p\"]\n").unwrap();
+        let err = catalog.add_sweeps(&sweeps).unwrap_err().to_string();
+        assert!(err.contains("[x]") && err.contains("method"), "{err}");
     }
 }

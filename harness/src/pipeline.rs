@@ -167,6 +167,14 @@ pub fn publish(
         &peers,
         &publish.meshes,
     )?;
+    let quality_time = report::quality_time::render_markdown(&run.results);
+    if !quality_time.is_empty() {
+        let path = dir.join("pareto.md");
+        meshes::io::atomic_write(&path, |w| {
+            w.write_all(format!("# Quality against time\n\n{quality_time}").as_bytes())
+                .map_err(meshes::MeshError::from)
+        })?;
+    }
     timed(RunPhase::Reports, start);
 
     let start = Instant::now();

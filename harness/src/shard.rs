@@ -44,7 +44,7 @@ impl fmt::Display for Shard {
 /// Seconds per 1000 vertices per edit step of each method: the median `total_s / (#V / 1000)` over the
 /// four survey tests of a `harness all` on this project's 2-core machine (at 11f8f45). Only the
 /// ratios matter: they make `arap` and `scale_aware` count for a hundred `isolines`.
-const SECONDS_PER_KILOVERTEX: [(&str, f64); 9] = [
+const SECONDS_PER_KILOVERTEX: [(&str, f64); 8] = [
     (methods::registry::LAPLACIAN, 0.10),
     (methods::registry::ARAP, 0.25),
     (methods::registry::HIRM, 0.043),
@@ -52,19 +52,22 @@ const SECONDS_PER_KILOVERTEX: [(&str, f64); 9] = [
     (methods::registry::SCALE_AWARE, 0.48),
     (methods::registry::SCALE_AWARE_ORA, 0.44),
     (methods::registry::ISOLINES, 0.0042),
-    (methods::registry::ISOLINES_10, 0.0035),
     (methods::registry::ISOLINES_T1, 0.0081),
 ];
 
-/// Estimated cost of running `methods` on `scenario` (in seconds on the reference machine; a method
-/// without a measured rate counts as the most expensive one).
+/// Estimated cost of running `methods` on `scenario` (in seconds on the reference machine; a sweep
+/// point, `isolines[isolines=10]`, at its base method's rate; a method without a measured rate
+/// counts as the most expensive one).
 pub fn estimated_cost(scenario: &LoadedScenario, methods: &[&str]) -> f64 {
     let slowest = SECONDS_PER_KILOVERTEX.iter().map(|(_, s)| *s).fold(0.0, f64::max);
     let kilovertices = scenario.mesh.n_vertices() as f64 / 1000.0;
     let steps = scenario.steps.len() as f64;
     methods
         .iter()
-        .map(|m| SECONDS_PER_KILOVERTEX.iter().find(|(name, _)| name == m).map_or(slowest, |(_, s)| *s))
+        .map(|m| {
+            let base = m.split('[').next().unwrap_or(m);
+            SECONDS_PER_KILOVERTEX.iter().find(|(name, _)| *name == base).map_or(slowest, |(_, s)| *s)
+        })
         .sum::<f64>()
         * kilovertices
         * steps

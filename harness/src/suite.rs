@@ -45,6 +45,8 @@ pub struct SuiteOptions {
     /// Add the peer methods of this file (`configs/peers.toml`, `--peers`) to every scenario that
     /// does not restrict its methods.
     pub peers: Option<PeerSetup>,
+    /// Add the parameter sweeps of this file (`configs/sweeps.toml`, `--sweeps`).
+    pub sweeps: Option<PathBuf>,
     /// Worker threads of every method ([`crate::threads`]).
     pub threads: usize,
     /// Cases run at a time, each in its own pool of `threads` workers (`--jobs`).
@@ -135,6 +137,9 @@ pub fn load_catalog(options: &SuiteOptions) -> Result<MethodCatalog, HarnessErro
     if let Some(peers) = &options.peers {
         catalog.add_peers(peers)?;
     }
+    if let Some(sweeps) = &options.sweeps {
+        catalog.add_sweeps(sweeps)?;
+    }
     Ok(catalog)
 }
 
@@ -172,15 +177,21 @@ fn select_specs(options: &SuiteOptions) -> Result<Vec<ScenarioSpec>, HarnessErro
 }
 
 /// The methods of each scenario the run covers, in catalog order: those its `methods` list names,
-/// else every method of the catalog (peers included when the run added them); `options.methods`
-/// applied.
+/// else every method of the catalog that runs there (peers included when the run added them, sweep
+/// points on their sweep file's scenarios); `options.methods` applied.
 fn plan(options: &SuiteOptions, catalog: &MethodCatalog, scenarios: &[LoadedScenario]) -> Vec<Vec<String>> {
     scenarios
         .iter()
         .map(|s| {
+            let name = &s.spec.name;
             catalog
-                .names()
-                .filter(|m| s.spec.methods.as_ref().is_none_or(|list| list.iter().any(|l| l == m)))
+                .methods()
+                .iter()
+                .filter(|m| match &s.spec.methods {
+                    Some(list) => list.contains(&m.name),
+                    None => m.runs_on.as_ref().is_none_or(|on| on.contains(name)),
+                })
+                .map(|m| m.name.as_str())
                 .filter(|m| options.methods.is_empty() || options.methods.iter().any(|x| x == m))
                 .map(str::to_string)
                 .collect()
@@ -406,10 +417,10 @@ impl SharedCases<'_> {
         self.bar.set_message(format!("{} / {}", scenario.spec.name, method.name));
         let rest = self.rests[s].get_or_init(|| RestGeometry::new(&scenario.mesh, &scenario.topology));
         let stderr_log = method.is_external().then(|| {
-            self.options
-                .reports_dir
-                .join("logs")
-                .join(format!("{}-{}.stderr.txt", scenario.spec.name, method.name))
+            self.options.reports_dir.join("logs").join(format!(
+                "{}.stderr.txt",
+                crate::report::case_file_stem(&scenario.spec.name, &method.name)
+            ))
         });
         run_case(
             scenario,
@@ -480,7 +491,9 @@ pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, Harne
             };
             let order = plan[i].iter().position(|m| *m == case.method).unwrap_or(usize::MAX);
             if !case.status.is_failed() {
-                let mesh_path = dir.join("meshes").join(format!("{}-{}.off", case.scenario, case.method));
+                let mesh_path = dir
+                    .join("meshes")
+                    .join(format!("{}.off", crate::report::case_file_stem(&case.scenario, &case.method)));
                 let mesh = meshes::io::read_mesh(&mesh_path)?;
                 case.positions = Some(
                     scenarios[i]

@@ -20,7 +20,6 @@ pub const SPECTRAL_MHB: &str = "spectral_mhb";
 pub const SCALE_AWARE: &str = "scale_aware";
 pub const SCALE_AWARE_ORA: &str = "scale_aware_ora";
 pub const ISOLINES: &str = "isolines";
-pub const ISOLINES_10: &str = "isolines_10";
 pub const ISOLINES_T1: &str = "isolines_t1";
 
 /// One registered method.
@@ -77,12 +76,6 @@ pub const METHODS: &[MethodEntry] = &[
         name: ISOLINES,
         summary: "handle-aware isolines reduced model (Au, Fu, Tai & Cohen-Or 2007), n_iso = 20, isoline-interpolated Laplacian coordinates (Table 1 t_2)",
         create: |p| Ok(Box::new(Isolines::new(ISOLINES, parse(ISOLINES, p)?)?)),
-        iterative: true,
-    },
-    MethodEntry {
-        name: ISOLINES_10,
-        summary: "`isolines` with n_iso = 10 (the coarser model of Au et al. 2007, Fig. 9)",
-        create: |p| Ok(Box::new(Isolines::new(ISOLINES_10, parse(ISOLINES_10, p)?)?)),
         iterative: true,
     },
     MethodEntry {

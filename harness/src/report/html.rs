@@ -177,6 +177,9 @@ pub fn render_index(
         .iter()
         .filter(|p| p.extension().is_some_and(|e| e == "png"))
         .partition(|p| p.starts_with("figures"));
+    let (pareto, plots): (Vec<&PathBuf>, Vec<&PathBuf>) =
+        plots.into_iter().partition(|p| caption_for(p).ends_with("-pareto"));
+    quality_against_time(&mut page, results, &pareto);
     let grids: Vec<&&PathBuf> = figures
         .iter()
         .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("grid")))
@@ -233,6 +236,46 @@ pub fn render_index(
         "</script>\n</body>\n</html>\n"
     ));
     page
+}
+
+/// "Quality against time": per test with sweep points its plot, budget table, fronts and points.
+fn quality_against_time(page: &mut String, results: &[CaseResult], plots: &[&PathBuf]) {
+    use crate::report::quality_time;
+    let scenarios = quality_time::swept_scenarios(results);
+    if scenarios.is_empty() {
+        return;
+    }
+    page.push_str(
+        "<h2 id=\"quality-time\">Quality against time (sweeps)</h2>\n<p>Each method's parameters swept \
+         (<code>--sweeps</code>, <code>configs/sweeps.toml</code>): every setting is a point named by its values, \
+         <code>isolines[isolines=10]</code>. Time per edit is bind + solve, what a user waits after moving a \
+         handle; the plots' right column adds the precompute. The budget table gives, for each time per edit, \
+         the <code>ok</code> setting with the lowest error within it.</p>\n",
+    );
+    for scenario in scenarios {
+        let cases: Vec<&CaseResult> = results.iter().filter(|r| r.scenario == scenario).collect();
+        let _ = writeln!(page, "<h3 id=\"quality-time-{s}\">{s}</h3>", s = escape(scenario));
+        if let Some(p) = plots.iter().find(|p| caption_for(p) == format!("{scenario}-pareto")) {
+            image(page, p, format!("{scenario}: quality against time"));
+        }
+        page.push_str(&markdown_table(&quality_time::budget_table(&cases)));
+        for m in crate::pareto::MEASURES {
+            let _ = writeln!(
+                page,
+                "<p>Front of {} against the time per edit: {}</p>",
+                escape(m.spec().label),
+                escape(&quality_time::front_list(&cases, m))
+            );
+        }
+        let _ = writeln!(
+            page,
+            "<details><summary>Every point of {} ({})</summary>",
+            escape(scenario),
+            cases.len()
+        );
+        page.push_str(&markdown_table(&quality_time::points_table(&cases)));
+        page.push_str("</details>\n");
+    }
 }
 
 /// A timing cell: the value, and below it the min–max range when it is a median of repetitions.

@@ -1,13 +1,32 @@
 //! Everything the harness writes for people to read: the result tables and meshes ([`tables`]),
-//! the plots ([`plots`]), our `arap` against libigl's ([`peer_comparison`]), two runs compared ([`run_comparison`]), the pictures ([`render`]), the HTML page ([`html`]) and the font they
+//! the plots ([`plots`]), quality against time with the budget tables ([`quality_time`]), our `arap` against libigl's ([`peer_comparison`]), two runs compared ([`run_comparison`]), the pictures ([`render`]), the HTML page ([`html`]) and the font they
 //! share ([`fonts`]). Each writer renders in memory first and writes its files atomically.
 
 pub mod fonts;
 pub mod html;
 pub mod peer_comparison;
 pub mod plots;
+pub mod quality_time;
 pub mod render;
 pub mod run_comparison;
 pub mod tables;
 
 pub use tables::*;
+
+/// `name` with every character other than ASCII letters, digits, `-`, `_` and `.` replaced by `_`,
+/// so it is one file name on every system.
+pub fn file_name(name: &str) -> String {
+    let cleaned: String =
+        name.chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '_' }).collect();
+    if cleaned.is_empty() || cleaned.chars().all(|c| c == '.') {
+        format!("_{cleaned}")
+    } else {
+        cleaned
+    }
+}
+
+/// The file stem of a case's files (`meshes/`, stderr logs): `<scenario>-<method>`, [`file_name`]d,
+/// so a sweep point's `isolines[isolines=10]` becomes `isolines_isolines_10_`.
+pub fn case_file_stem(scenario: &str, method: &str) -> String {
+    format!("{}-{}", file_name(scenario), file_name(method))
+}

@@ -7,7 +7,11 @@
 //! - `scaling`: log-log per-iteration time against vertex count over the resolution sweeps
 //!   (scenarios named `*-sweep-*`), one line per method;
 //! - `table1`: HIRM's Table 1 as a chart, handle-set update time against the number of handles,
-//!   `hirm`'s `t_h` and the `isolines` rebuild, per `*-handles` scenario.
+//!   `hirm`'s `t_h` and the `isolines` rebuild, per `*-handles` scenario;
+//! - `<scenario>-pareto`, for a scenario with sweep points ([`crate::sweep`]): quality against time
+//!   ([`crate::pareto`]), a row per measure (E_theta, E_phi, e_area), a column per time (per edit;
+//!   with the precompute), each sweep's points joined in parameter order, the front across all
+//!   methods as a black staircase, suspect points crossed.
 //!
 //! Every file is drawn to a temporary name and renamed when complete, so a failure leaves no
 //! half-written plot.
@@ -26,6 +30,8 @@ use crate::metrics::{MetricSpec, METRICS};
 const SIZE: (u32, u32) = (960, 540);
 /// Pixel size of the errors plot (one panel per plotted metric, side by side).
 const ERRORS_SIZE: (u32, u32) = (1500, 560);
+/// Pixel size of the quality–time plot (three measures by two time axes).
+const PARETO_SIZE: (u32, u32) = (1600, 1500);
 
 /// Method colours, fixed by registry order so a method has the same colour in every plot; the other
 /// methods (external, peers) of `cases` follow in their order there, which is the catalog's in every
@@ -74,11 +80,15 @@ pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, H
             scenarios.push(&r.scenario);
         }
     }
+    let swept = crate::report::quality_time::swept_scenarios(results);
     for scenario in scenarios {
         let cases: Vec<&CaseResult> = results.iter().filter(|r| r.scenario == scenario).collect();
         written.extend(save(dir, &format!("{scenario}-errors"), &Plot::Errors(scenario, &cases))?);
         written.extend(save(dir, &format!("{scenario}-timings"), &Plot::Timings(scenario, &cases))?);
         written.extend(save(dir, &format!("{scenario}-convergence"), &Plot::Convergence(scenario, &cases))?);
+        if swept.contains(&scenario) {
+            written.extend(save(dir, &format!("{scenario}-pareto"), &Plot::Pareto(scenario, &cases))?);
+        }
     }
     let sweeps: Vec<&CaseResult> =
         results.iter().filter(|r| r.scenario.contains("-sweep-") && !r.status.is_failed()).collect();
@@ -108,6 +118,7 @@ enum Plot<'a> {
     Convergence(&'a str, &'a [&'a CaseResult]),
     Scaling(&'a [&'a CaseResult]),
     Table1(&'a [&'a CaseResult]),
+    Pareto(&'a str, &'a [&'a CaseResult]),
 }
 
 impl Plot<'_> {
@@ -115,6 +126,7 @@ impl Plot<'_> {
     fn size(&self) -> (u32, u32) {
         match self {
             Plot::Errors(..) => ERRORS_SIZE,
+            Plot::Pareto(..) => PARETO_SIZE,
             _ => SIZE,
         }
     }
@@ -126,6 +138,7 @@ impl Plot<'_> {
             Plot::Convergence(scenario, cases) => draw_convergence(root, scenario, cases),
             Plot::Scaling(cases) => draw_scaling(root, cases),
             Plot::Table1(cases) => draw_table1(root, cases),
+            Plot::Pareto(scenario, cases) => draw_pareto(root, scenario, cases),
         }
     }
 }
@@ -604,4 +617,139 @@ fn draw_table1<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult]) ->
         labelled_line(&mut chart, points, color, style, label)?;
     }
     draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 14)
+}
+
+/// The base method of a sweep point (`isolines` of `isolines[isolines=10]`): its colour.
+fn base_method(method: &str) -> &str {
+    method.split('[').next().unwrap_or(method)
+}
+
+/// Quality against time for one scenario: a panel per measure of [`crate::pareto::MEASURES`] (rows)
+/// and time axis (columns).
+fn draw_pareto<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &[&CaseResult]) -> DrawResult {
+    use crate::pareto::{TimeAxis, MEASURES};
+    root.fill(&WHITE).map_err(err)?;
+    let root = root
+        .titled(
+            &format!("{scenario}: quality against time; black: the front of the ok settings (none both faster and better); x: suspect"),
+            ("sans-serif", 24),
+        )
+        .map_err(err)?;
+    let panels = root.split_evenly((MEASURES.len(), TimeAxis::ALL.len()));
+    for (i, panel) in panels.iter().enumerate() {
+        let measure = MEASURES[i / TimeAxis::ALL.len()];
+        let axis = TimeAxis::ALL[i % TimeAxis::ALL.len()];
+        draw_pareto_panel(panel, cases, measure, axis, i == 0)?;
+    }
+    Ok(())
+}
+
+fn draw_pareto_panel<DB: DrawingBackend>(
+    root: &Area<'_, DB>,
+    cases: &[&CaseResult],
+    measure: crate::metrics::Metric,
+    axis: crate::pareto::TimeAxis,
+    legend: bool,
+) -> DrawResult {
+    use crate::pareto::{ok_front, points};
+    // Log axes need positive values: a time or error of 0 sits at the axis' floor.
+    const FLOOR: f64 = 1e-6;
+    let placed = points(cases, axis, measure);
+    if placed.is_empty() {
+        return Ok(());
+    }
+    let xy = |p: &crate::pareto::Point| (p.time.max(FLOOR), p.error.max(FLOOR));
+    let (x0, x1) =
+        placed.iter().fold((f64::INFINITY, 0.0f64), |(a, b), (_, p)| (a.min(xy(p).0), b.max(xy(p).0)));
+    let (y0, y1) =
+        placed.iter().fold((f64::INFINITY, 0.0f64), |(a, b), (_, p)| (a.min(xy(p).1), b.max(xy(p).1)));
+    let spec = measure.spec();
+    let unit = if spec.unit.is_empty() { String::new() } else { format!(" ({})", spec.unit) };
+    let mut chart = ChartBuilder::on(root)
+        .caption(format!("{}{unit} against {}", spec.label, axis.label()), ("sans-serif", 17))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d((x0 * 0.6..x1 * 1.7).log_scale(), (y0 * 0.8..y1 * 1.25).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(axis.label())
+        .y_desc(format!("{}{unit}", spec.label))
+        .x_labels(6)
+        .y_labels(6)
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_label_formatter(&|v| format!("{}", round_to_two_digits(*v)))
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
+
+    // Each sweep's points in parameter order, in its base method's colour.
+    let mut sweeps: Vec<&str> = Vec::new();
+    for (c, _) in &placed {
+        for p in &c.sweeps {
+            if !sweeps.contains(&p.sweep.as_str()) {
+                sweeps.push(&p.sweep);
+            }
+        }
+    }
+    for sweep in sweeps {
+        let mut line: Vec<(usize, &CaseResult, (f64, f64))> = placed
+            .iter()
+            .filter_map(|(c, p)| c.sweeps.iter().find(|s| s.sweep == sweep).map(|s| (s.position, *c, xy(p))))
+            .collect();
+        line.sort_by_key(|(position, _, _)| *position);
+        let Some((_, first, _)) = line.first() else { continue };
+        let color = method_color(base_method(&first.method), cases);
+        chart
+            .draw_series(LineSeries::new(line.iter().map(|(_, _, p)| *p), color.mix(0.6).stroke_width(1)))
+            .map_err(err)?;
+    }
+    // The front of the ok points: a staircase through them, fastest first.
+    let on = ok_front(&placed);
+    let mut stairs: Vec<(f64, f64)> = Vec::new();
+    for &i in &on {
+        let (x, y) = xy(&placed[i].1);
+        if let Some(&(_, last_y)) = stairs.last() {
+            stairs.push((x, last_y));
+        }
+        stairs.push((x, y));
+    }
+    if let Some(&(_, y)) = stairs.last() {
+        stairs.push((x1 * 1.7, y));
+    }
+    chart.draw_series(LineSeries::new(stairs, BLACK.stroke_width(2))).map_err(err)?;
+
+    // The points: one legend entry per base method.
+    let mut labelled: Vec<&str> = Vec::new();
+    for (c, p) in &placed {
+        let base = base_method(&c.method);
+        let color = method_color(base, cases);
+        let at = xy(p);
+        let series = chart.draw_series(std::iter::once(Circle::new(at, 5, color.filled()))).map_err(err)?;
+        if legend && !labelled.contains(&base) {
+            labelled.push(base);
+            series.label(base.to_string()).legend(move |(x, y)| Circle::new((x + 8, y), 5, color.filled()));
+        }
+        if c.status.is_suspect() {
+            chart
+                .draw_series(std::iter::once(Cross::new(at, 7, RGBColor(200, 0, 0).stroke_width(2))))
+                .map_err(err)?;
+        }
+    }
+    // The front's points by name, so a reader can tell which setting it is.
+    for &i in &on {
+        let (c, p) = &placed[i];
+        chart
+            .draw_series(std::iter::once(Text::new(
+                format!(" {}", c.method),
+                xy(p),
+                ("sans-serif", 12).into_font().color(&BLACK),
+            )))
+            .map_err(err)?;
+    }
+    if legend {
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 13)?;
+    }
+    Ok(())
 }

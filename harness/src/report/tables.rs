@@ -410,7 +410,7 @@ fn write_meshes(
         }
         // In the input file's vertex order, so per-vertex data of the input still applies.
         let mesh = scenario.in_input_order(positions)?;
-        let stem = format!("{}-{}", r.scenario, r.method);
+        let stem = super::case_file_stem(&r.scenario, &r.method);
         if output.format.writes_off() {
             meshes::io::write_off(mesh_dir.join(format!("{stem}.off")), &mesh)?;
         }

@@ -80,8 +80,8 @@ pub enum LaplacianCoordinates {
     Vertices,
 }
 
-/// Parameters of [`Isolines`] (configs/methods.toml, sections `[isolines]`, `[isolines_10]`,
-/// `[isolines_t1]`).
+/// Parameters of [`Isolines`] (configs/methods.toml, sections `[isolines]` and
+/// `[isolines_t1]`; the sweep points `isolines[isolines=10]` and others lay their values over `[isolines]`).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct IsolinesParams {

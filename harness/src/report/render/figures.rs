@@ -99,11 +99,11 @@ pub fn write_figures(
     std::fs::create_dir_all(&figures).map_err(|error| HarnessError::Io { path: figures.clone(), error })?;
     let mut files: Vec<(PathBuf, &RgbImage)> = Vec::new();
     for (row, images) in rows.iter().zip(&rendered) {
-        let stem = file_name(&row.scenario.spec.name);
+        let stem = crate::report::file_name(&row.scenario.spec.name);
         files.push((Path::new(FIGURES).join(format!("{stem}-rest.png")), &images.rest));
         for (case, cell) in row.cases.iter().zip(&images.cells) {
             if let (Some(case), Cell::Rendered { shaded, heat, area, .. }) = (case, cell) {
-                let stem = format!("{stem}-{}", file_name(&case.method));
+                let stem = format!("{stem}-{}", crate::report::file_name(&case.method));
                 files.push((Path::new(FIGURES).join(format!("{stem}.png")), shaded));
                 files.push((Path::new(FIGURES).join(format!("{stem}-heat.png")), heat));
                 files.push((Path::new(FIGURES).join(format!("{stem}-area.png")), area));
@@ -534,18 +534,6 @@ fn wrap(text: &str, size: f64, max_width: f64) -> Result<Vec<String>, String> {
     Ok(lines)
 }
 
-/// `name` with every character other than ASCII letters, digits, `-`, `_` and `.` replaced by `_`,
-/// so it is one file name on every system.
-fn file_name(name: &str) -> String {
-    let cleaned: String =
-        name.chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '_' }).collect();
-    if cleaned.is_empty() || cleaned.chars().all(|c| c == '.') {
-        format!("_{cleaned}")
-    } else {
-        cleaned
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -787,9 +775,9 @@ mod tests {
 
     #[test]
     fn file_names_keep_safe_characters_only() {
-        assert_eq!(file_name("bar-sweep_6k.v2"), "bar-sweep_6k.v2");
-        assert_eq!(file_name("a/b c\\d"), "a_b_c_d");
-        assert_eq!(file_name(".."), "_..");
-        assert_eq!(file_name(""), "_");
+        assert_eq!(crate::report::file_name("bar-sweep_6k.v2"), "bar-sweep_6k.v2");
+        assert_eq!(crate::report::file_name("a/b c\\d"), "a_b_c_d");
+        assert_eq!(crate::report::file_name(".."), "_..");
+        assert_eq!(crate::report::file_name(""), "_");
     }
 }

@@ -1,0 +1,155 @@
+//! `pareto.md` and the page's "Quality against time": for every test with sweep points
+//! ([`crate::sweep`]), the budget table (for each time per edit of [`BUDGETS_S`], the `ok` case with
+//! the lowest error, per measure of [`MEASURES`]), the front of each measure against the time per
+//! edit, and every point with its parameters, times, measures and status.
+
+use std::fmt::Write as _;
+
+use crate::case::CaseResult;
+use crate::pareto::{best_within, budget_label, ok_front, points, TimeAxis, BUDGETS_S, MEASURES};
+
+/// The fewest settings of one sweep on a test that make it a swept test: a trade-off needs a line,
+/// and `isolines[isolines=10]` beside `isolines` in every run is not a sweep run.
+pub const MIN_SWEEP_POINTS: usize = 3;
+
+/// The tests of `results` on which some sweep has at least [`MIN_SWEEP_POINTS`] cases, in report
+/// order.
+pub fn swept_scenarios(results: &[CaseResult]) -> Vec<&str> {
+    let mut out: Vec<&str> = Vec::new();
+    for r in results.iter().filter(|r| !r.sweeps.is_empty()) {
+        if out.contains(&r.scenario.as_str()) {
+            continue;
+        }
+        let swept = r.sweeps.iter().any(|p| {
+            results
+                .iter()
+                .filter(|c| c.scenario == r.scenario && c.sweeps.iter().any(|q| q.sweep == p.sweep))
+                .count()
+                >= MIN_SWEEP_POINTS
+        });
+        if swept {
+            out.push(&r.scenario);
+        }
+    }
+    out
+}
+
+/// A measure's value with its unit, if it has one: `9.07 °`, `0.0439`.
+fn value_text(measure: crate::metrics::Metric, value: f64) -> String {
+    let spec = measure.spec();
+    let text = spec.format.apply(Some(value));
+    if spec.unit.is_empty() {
+        text
+    } else {
+        format!("{text} {}", spec.unit)
+    }
+}
+
+/// A time in the unit that reads best: `0.42 ms`, `3.1 s`.
+fn seconds_text(s: f64) -> String {
+    if !s.is_finite() {
+        "–".into()
+    } else if s < 1.0 {
+        format!("{:.3} ms", s * 1e3)
+    } else {
+        format!("{s:.2} s")
+    }
+}
+
+/// The budget table of one test (markdown): a row per budget, a column per measure, each cell the
+/// best `ok` case within the budget per edit, its value and its time.
+pub fn budget_table(cases: &[&CaseResult]) -> String {
+    let mut md = String::from("| budget per edit |");
+    for m in MEASURES {
+        let _ = write!(md, " best by {} |", m.spec().label);
+    }
+    md.push('\n');
+    md.push_str(&"|---".repeat(MEASURES.len() + 1));
+    md.push_str("|\n");
+    for budget in BUDGETS_S {
+        let _ = write!(md, "| {} |", budget_label(budget));
+        for measure in MEASURES {
+            let placed = points(cases, TimeAxis::Edit, measure);
+            let coordinates: Vec<_> = placed.iter().map(|(_, p)| *p).collect();
+            let ok: Vec<bool> = placed.iter().map(|(c, _)| c.status.is_ok()).collect();
+            match best_within(&coordinates, &ok, budget) {
+                Some(i) => {
+                    let _ = write!(
+                        md,
+                        " {}: {}, {} |",
+                        placed[i].0.method,
+                        value_text(measure, coordinates[i].error),
+                        seconds_text(coordinates[i].time)
+                    );
+                }
+                None => md.push_str(" none `ok` within it |"),
+            }
+        }
+        md.push('\n');
+    }
+    md
+}
+
+/// The front of the `ok` cases by `measure` against the time per edit (one line, fastest first).
+pub fn front_list(cases: &[&CaseResult], measure: crate::metrics::Metric) -> String {
+    let placed = points(cases, TimeAxis::Edit, measure);
+    ok_front(&placed)
+        .into_iter()
+        .map(|i| {
+            let (c, p) = &placed[i];
+            format!("{} {} at {}", c.method, value_text(measure, p.error), seconds_text(p.time))
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// Every case of one test as a point (markdown table): its sweeps and values, both times, the
+/// measures, the status.
+pub fn points_table(cases: &[&CaseResult]) -> String {
+    let mut md = String::from("| method | sweep: values | per edit | with precompute |");
+    for m in MEASURES {
+        let _ = write!(md, " {} |", m.spec().label);
+    }
+    md.push_str(" status |\n");
+    md.push_str(&"|---".repeat(MEASURES.len() + 5));
+    md.push_str("|\n");
+    for c in cases {
+        let sweeps =
+            c.sweeps.iter().map(|p| format!("{}: {}", p.sweep, p.values)).collect::<Vec<_>>().join("; ");
+        let _ = write!(
+            md,
+            "| {} | {} | {} | {} |",
+            c.method,
+            if sweeps.is_empty() { "–".to_string() } else { sweeps },
+            seconds_text(TimeAxis::Edit.seconds(c)),
+            seconds_text(TimeAxis::WithPrecompute.seconds(c))
+        );
+        for m in MEASURES {
+            let _ = write!(md, " {} |", m.spec().format.apply(c.quality.get(m)));
+        }
+        let _ = writeln!(md, " {} |", c.status.kind());
+    }
+    md
+}
+
+/// `pareto.md`: per swept test its budget table, fronts and points (empty without sweep points).
+pub fn render_markdown(results: &[CaseResult]) -> String {
+    let mut md = String::new();
+    for scenario in swept_scenarios(results) {
+        let cases: Vec<&CaseResult> = results.iter().filter(|r| r.scenario == scenario).collect();
+        let _ = writeln!(md, "## {scenario}\n\nThe `ok` case with the lowest error within each time per edit (bind + solve):\n");
+        md.push_str(&budget_table(&cases));
+        md.push('\n');
+        for m in MEASURES {
+            let _ = writeln!(
+                md,
+                "Front of {} against the time per edit: {}\n",
+                m.spec().label,
+                front_list(&cases, m)
+            );
+        }
+        md.push_str(&points_table(&cases));
+        md.push('\n');
+    }
+    md
+}
