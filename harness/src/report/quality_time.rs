@@ -82,7 +82,7 @@ pub fn budget_table(cases: &[&CaseResult]) -> String {
                         seconds_text(coordinates[i].time)
                     );
                 }
-                None => md.push_str(" none `ok` within it |"),
+                None => md.push_str(" none ok within it |"),
             }
         }
         md.push('\n');
