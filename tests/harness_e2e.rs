@@ -257,7 +257,7 @@ fn without_survey_data_the_procedural_look_alikes_run_and_are_labelled() {
     let code = run(&args).unwrap();
     assert_eq!(code, std::process::ExitCode::SUCCESS);
     let rows = support::csv_rows(&reports.path().join("results.csv"));
-    assert_eq!(rows.len(), 4 * methods::registry::METHODS.len());
+    assert_eq!(rows.len(), 4 * configured_methods(), "every method of configs/methods.toml on each test");
     for row in &rows {
         assert_eq!(row["mesh_source"], "procedural look-alike");
         assert!(
@@ -327,6 +327,32 @@ fn chromium() -> Option<PathBuf> {
 /// Open `page` in headless Chromium and read the count its script writes into `#image-check`:
 /// `(images loaded, images on the page)`.
 fn images_loaded_in_chromium(chromium: &Path, page: &Path) -> (usize, usize) {
+    let url = format!("file://{}", page.canonicalize().unwrap().display());
+    let (dom, stderr) = dump_dom(chromium, &url);
+    let check = dom
+        .split("<p id=\"image-check\"")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no #image-check in the DOM; chromium said: {stderr}"));
+    let attribute = |name: &str| -> usize {
+        let value = check.split(&format!("{name}=\"")).nth(1).and_then(|v| v.split('"').next()).unwrap_or("");
+        value
+            .parse()
+            .unwrap_or_else(|_| panic!("#image-check {name} = {value:?} (the page script did not run)"))
+    };
+    let broken = check.split("data-broken=\"").nth(1).and_then(|v| v.split('"').next()).unwrap_or("");
+    assert!(broken.is_empty(), "images that did not load: {broken}");
+    (attribute("data-loaded"), attribute("data-total"))
+}
+
+/// How many methods configs/methods.toml gives a run: the registered ones and its variants and
+/// sweep points (`isolines[isolines=10]`).
+fn configured_methods() -> usize {
+    let path = support::workspace_root().join("configs/methods.toml");
+    harness::config::MethodCatalog::load(&path).unwrap().methods().len()
+}
+
+/// The DOM of `url` after headless Chromium ran its scripts, and what Chromium said on stderr.
+fn dump_dom(chromium: &Path, url: &str) -> (String, String) {
     let profile = tempfile::tempdir().unwrap();
     let out = std::process::Command::new(chromium)
         .args([
@@ -343,22 +369,104 @@ fn images_loaded_in_chromium(chromium: &Path, page: &Path) -> (usize, usize) {
         ])
         .arg(format!("--user-data-dir={}", profile.path().display()))
         .arg("--dump-dom")
-        .arg(format!("file://{}", page.canonicalize().unwrap().display()))
+        .arg(url)
         .output()
         .expect("run chromium");
-    let dom = String::from_utf8_lossy(&out.stdout);
-    let check = dom.split("<p id=\"image-check\"").nth(1).unwrap_or_else(|| {
-        panic!("no #image-check in the DOM; chromium said: {}", String::from_utf8_lossy(&out.stderr))
-    });
-    let attribute = |name: &str| -> usize {
-        let value = check.split(&format!("{name}=\"")).nth(1).and_then(|v| v.split('"').next()).unwrap_or("");
-        value
-            .parse()
-            .unwrap_or_else(|_| panic!("#image-check {name} = {value:?} (the page script did not run)"))
+    (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// The value of attribute `name` in the start tag `tag` (its text up to `>`).
+fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+    tag.split(&format!(" {name}=\"")).nth(1).and_then(|v| v.split('"').next())
+}
+
+#[test]
+fn the_page_ranks_sorts_and_filters_as_its_address_asks_in_chromium() {
+    // spectral_mhb misses its soft handles on these two: suspect rows beside ok ones.
+    let scenario = |shape: &str, n: usize| {
+        (
+            format!("{shape}.toml"),
+            format!(
+                "name = \"{shape}\"\nprocedural = {{ shape = \"{shape}\", vertices = {n} }}\n\
+                 methods = [\"laplacian\", \"arap\", \"isolines\", \"spectral_mhb\"]\n"
+            ),
+        )
     };
-    let broken = check.split("data-broken=\"").nth(1).and_then(|v| v.split('"').next()).unwrap_or("");
-    assert!(broken.is_empty(), "images that did not load: {broken}");
-    (attribute("data-loaded"), attribute("data-total"))
+    let configs = configs_with(&[scenario("bar", 2000), scenario("cylinder", 1500)]);
+    let reports = tempfile::tempdir().unwrap();
+    let args = ["all", "--quiet", "--no-check", "--configs", configs.path().to_str().unwrap()];
+    assert_eq!(
+        run(&[&args[..], &["--reports", reports.path().to_str().unwrap()]].concat()).unwrap(),
+        std::process::ExitCode::SUCCESS
+    );
+    let Some(chromium) = chromium() else { return };
+    let rows = support::csv_rows(&reports.path().join("results.csv"));
+    let index = reports.path().join("index.html").canonicalize().unwrap();
+    let url = format!("file://{}?sort=e_theta_deg&desc=1&status=ok&rank=e_phi_deg", index.display());
+    let (dom, stderr) = dump_dom(&chromium, &url);
+    let table = dom.split("id=\"results-table\"").nth(1).unwrap_or_else(|| panic!("no table; {stderr}"));
+    let body = table.split("<tbody>").nth(1).unwrap().split("</tbody>").next().unwrap();
+    // (method, scenario, status, hidden) of each row, in the order the page shows them.
+    let shown: Vec<(String, String, String, bool)> = body
+        .split("<tr ")
+        .skip(1)
+        .map(|tr| {
+            let tag = tr.split('>').next().unwrap();
+            let get =
+                |n: &str| attribute(tag, n).unwrap_or_else(|| panic!("no {n} in <tr {tag}>")).to_string();
+            (get("data-method"), get("data-scenario"), get("data-status"), tag.contains(" hidden"))
+        })
+        .collect();
+    assert_eq!(shown.len(), rows.len(), "every case is a row");
+    let visible: Vec<&(String, String, String, bool)> = shown.iter().filter(|r| !r.3).collect();
+    let ok = rows.iter().filter(|r| r["status"] == "ok").count();
+    assert!(ok > 0 && ok < rows.len(), "the fixture has ok and other cases ({ok} of {})", rows.len());
+    assert_eq!(visible.len(), ok, "status=ok shows the ok rows only");
+    assert!(visible.iter().all(|r| r.2 == "ok"));
+    let e_theta = |r: &(String, String, String, bool)| {
+        let row = rows.iter().find(|c| c["method"] == r.0 && c["scenario"] == r.1).unwrap();
+        support::num(row, "e_theta_deg")
+    };
+    let order: Vec<f64> = visible.iter().map(|r| e_theta(r)).collect();
+    assert!(order.windows(2).all(|w| w[0] >= w[1]), "sorted by E_theta descending: {order:?}");
+    assert!(dom.contains(&format!("data-shown=\"{ok}\"")), "the row count says {ok}");
+    // The ranking by E_phi: per test, the best finished case first.
+    for scenario in ["bar", "cylinder"] {
+        let ranked = dom
+            .split(&format!("<table class=\"ranking\" data-scenario=\"{scenario}\">"))
+            .nth(1)
+            .unwrap_or_else(|| panic!("no ranking of {scenario}"));
+        let first = ranked.split("<tr class=\"").nth(1).unwrap();
+        let first = format!(" class=\"{first}");
+        let first_method = attribute(first.split('>').next().unwrap(), "data-method").unwrap();
+        let best = rows
+            .iter()
+            .filter(|r| {
+                r["scenario"] == scenario && (r["status"] == "ok" || r["status"].starts_with("suspect"))
+            })
+            .min_by(|a, b| support::num(a, "e_phi_deg").total_cmp(&support::num(b, "e_phi_deg")))
+            .unwrap();
+        assert_eq!(first_method, best["method"], "{scenario}: best by E_phi");
+    }
+    assert!(dom.contains("id=\"median-ranks\""));
+
+    // The 3D view of a case opened from the address, with another method on the left: it loads
+    // the case's files and draws both canvases (pixels that are not background).
+    let url = format!("file://{}?view=bar-arap&left=isolines&colour=angle", index.display());
+    let (dom, stderr) = dump_dom(&chromium, &url);
+    let viewer = dom.split("<div id=\"viewer\"").nth(1).unwrap_or_else(|| panic!("no viewer; {stderr}"));
+    let tag = viewer.split('>').next().unwrap();
+    assert!(!tag.contains(" hidden"), "the view is open: <div id=\"viewer\"{tag}>");
+    assert_eq!(attribute(tag, "data-view"), Some("bar-arap"));
+    let pixels: usize =
+        attribute(tag, "data-pixels").unwrap_or_else(|| panic!("not drawn; {stderr}")).parse().unwrap();
+    assert!(pixels > 5_000, "{pixels} drawn pixels in the smaller canvas");
+    assert_eq!(attribute(tag, "data-left"), Some("isolines"), "isolines on the left");
+    // Every case with a result has its file; the page itself carries no mesh.
+    for row in &rows {
+        let stem = harness::report::case_file_stem(&row["scenario"], &row["method"]);
+        assert!(reports.path().join(format!("viewer/{stem}.js")).is_file(), "viewer/{stem}.js");
+    }
 }
 
 /// A tiny survey-format data set (procedural bar written as .off/.sel/.def) and a configs directory
@@ -1014,7 +1122,7 @@ fn the_real_mesh_suite_runs_from_toml_alone() {
     ];
     assert_eq!(run(&args).unwrap(), std::process::ExitCode::SUCCESS);
     let rows = support::csv_rows(&reports.path().join("results.csv"));
-    assert_eq!(rows.len(), 4 * methods::registry::METHODS.len());
+    assert_eq!(rows.len(), 4 * configured_methods(), "every method of configs/methods.toml on each test");
     for (scenario, vertices) in [("knight", 502), ("max", 5272), ("bunny", 3485), ("armadillo", 43243)] {
         for row in rows.iter().filter(|r| r["scenario"] == scenario) {
             assert_eq!(row["mesh_source"], "file");

@@ -167,6 +167,9 @@ pub fn publish(
         &peers,
         &publish.meshes,
     )?;
+    let viewable = report::viewer::write_viewer_data(dir, &run.results, &run.scenarios, |s| {
+        publish.meshes.every_scenario || s.spec.writes_result_meshes()
+    })?;
     let quality_time = report::quality_time::render_markdown(&run.results);
     if !quality_time.is_empty() {
         let path = dir.join("pareto.md");
@@ -204,6 +207,7 @@ pub fn publish(
             &peers,
             &outcome,
             &run.notes,
+            &viewable,
         ),
     )?;
     timed(RunPhase::GateAndIndex, start);

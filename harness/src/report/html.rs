@@ -37,6 +37,7 @@ pub fn render_index(
     peers: &str,
     gate: &GateOutcome,
     notes: &[String],
+    viewable: &[String],
 ) -> String {
     let mut page = String::new();
     page.push_str(concat!(
@@ -53,16 +54,155 @@ pub fn render_index(
         ".pass{color:#060}.fail{color:#a00}\n",
         "img{max-width:100%;border:1px solid #ddd;margin:4px 0}\n",
         "figure{margin:1em 0}figcaption{font-size:13px;color:#555}\n",
+        "div.scroll{max-height:85vh;overflow:auto}#results-table{margin:0}\n",
+        "#results-table thead th{position:sticky;top:0;z-index:2}\n",
+        "#results-table td:nth-child(-n+2),#results-table th:nth-child(-n+2){position:sticky;left:0;z-index:1}\n",
+        "#results-table thead th:nth-child(-n+2){z-index:3}#results-table td:nth-child(-n+2){background:#fff}\n",
+        "tr.suspect td:nth-child(-n+2){background:#fff1d6}tr.failed td:nth-child(-n+2){background:#fdd}\n",
+        "tr.unfinished td:nth-child(-n+2){background:#e4e8ff}\n",
+        "tr.viewable{cursor:pointer}tr.viewable:hover td{outline:1px solid #99c}\n",
+        "#viewer canvas{border:1px solid #ccc;margin-right:8px;max-width:48%}\n",
+        "th.sortable{cursor:pointer}th.sorted-up::after{content:' ▲'}th.sorted-down::after{content:' ▼'}\n",
+        "#filters label{margin-right:1em;font-size:14px}#row-count{font-size:13px;color:#555}\n",
+        "div.ranking-grid{display:flex;flex-wrap:wrap;gap:1em}table.ranking{margin:0}\n",
+        "table.ranking caption,#median-ranks caption{font-weight:bold;text-align:left}\n",
+        "table.ranking tr.ok td{background:#e6f5e6}\n",
         "</style>\n</head>\n<body>\n",
         "<h1>deformbench: handle-based mesh deformation, side by side</h1>\n"
     ));
     let _ = writeln!(
         page,
-        "<p>Data: {}. Times in seconds, iteration times in milliseconds. Every measure compares the result \
-         with the rest mesh:</p>",
+        "<p>Data: {}. Times in seconds, iteration times in milliseconds.</p>",
         escape(data_source)
     );
     let _ = writeln!(page, "<p id=\"provenance\">Made by this {}.</p>", escape(provenance));
+    page.push_str("<h2 id=\"verdict\">Quality regression gate</h2>\n");
+    match gate {
+        GateOutcome::Checked { baseline, findings } => {
+            let regressions = gate.regressions();
+            let name = escape(&baseline.display().to_string());
+            if regressions == 0 {
+                let _ = writeln!(page, "<p class=\"pass\">No regression against <code>{name}</code>.</p>");
+            } else {
+                let _ = writeln!(
+                    page,
+                    "<p class=\"fail\">{regressions} regression(s) against <code>{name}</code>:</p>"
+                );
+            }
+            if !findings.is_empty() {
+                page.push_str("<ul>\n");
+                for f in findings {
+                    let _ = writeln!(page, "<li>{}</li>", escape(&f.to_string()));
+                }
+                page.push_str("</ul>\n");
+            }
+        }
+        GateOutcome::NotChecked(reason) => {
+            let _ = writeln!(page, "<p>Not checked: {}</p>", escape(reason));
+        }
+    }
+    answer_first(&mut page);
+
+    page.push_str(
+        "<h2 id=\"results\">Results</h2>\n<div id=\"filters\"></div>\n<div class=\"scroll\"><table id=\"results-table\">\n<thead><tr>\
+         <th data-key=\"scenario\">scenario</th><th data-key=\"method\">method</th>\
+         <th data-key=\"status\">status</th><th data-key=\"vertices\">#V</th>\
+         <th data-key=\"iterations\">iterations</th><th data-key=\"converged\">converged</th>\
+         <th data-key=\"startup_s\" title=\"an external method's process start-up, not part of precompute\">startup</th>\
+         <th data-key=\"precompute_s\">precompute</th><th data-key=\"bind_s\">bind</th><th data-key=\"solve_s\">solve</th>\
+         <th data-key=\"total_s\">total</th><th data-key=\"median_iteration_ms\">iteration (ms)</th>\
+         <th data-key=\"peak_memory_mib\" title=\"what the method added to the resident memory at its peak (one case at a time only)\">peak memory (MiB)</th>",
+    );
+    for spec in &METRICS {
+        let _ = write!(
+            page,
+            "<th data-key=\"{}\" data-better=\"{}\" title=\"{}\">{}</th>",
+            spec.key,
+            better_word(spec.better),
+            escape(spec.doc),
+            escape(spec.label)
+        );
+    }
+    page.push_str(
+        "<th data-key=\"self_intersecting\">self-intersecting (open3d)</th></tr></thead>\n<tbody>\n",
+    );
+    for r in results {
+        let (class, badge) = match r.origin {
+            Origin::BuiltIn => (r.status.kind().to_string(), String::new()),
+            other => (
+                format!("{} {}", r.status.kind(), other.label()),
+                format!(
+                    "<span class=\"origin\" title=\"{}\">{}</span>",
+                    escape(r.about.as_deref().unwrap_or("")),
+                    other.label()
+                ),
+            ),
+        };
+        let _ = write!(
+            page,
+            "<tr class=\"{class}\" data-scenario=\"{}\" data-method=\"{}\" data-status=\"{}\" data-source=\"{}\"{}>\
+             <td class=\"text\">{}</td><td class=\"text\">{}{badge}</td><td class=\"text status\">{}</td>\
+             <td data-v=\"{}\">{}</td><td data-v=\"{}\">{}</td><td>{}</td>{}{}{}{}{}{}<td data-v=\"{}\">{}</td>",
+            escape(&r.scenario),
+            escape(&r.method),
+            r.status.kind(),
+            escape(&r.mesh_source),
+            {
+                let stem = crate::report::case_file_stem(&r.scenario, &r.method);
+                if viewable.contains(&stem) {
+                    format!(
+                        " data-view=\"{}\" data-rest=\"{}.rest\"",
+                        escape(&stem),
+                        escape(&crate::report::file_name(&r.scenario))
+                    )
+                } else {
+                    String::new()
+                }
+            },
+            escape(&r.scenario),
+            escape(&r.method),
+            escape(&r.status.to_string()),
+            r.vertices,
+            r.vertices,
+            r.iterations,
+            r.iterations,
+            if r.converged { "yes" } else { "no" },
+            timing(r.startup_s, r.spread.map(|s| (s.repetitions, s.startup_s)), 3),
+            timing(r.precompute_s, r.spread.map(|s| (s.repetitions, s.precompute_s)), 3),
+            timing(r.bind_s, r.spread.map(|s| (s.repetitions, s.bind_s)), 4),
+            timing(r.solve_s, r.spread.map(|s| (s.repetitions, s.solve_s)), 3),
+            timing(r.total_s, r.spread.map(|s| (s.repetitions, s.total_s)), 3),
+            timing(r.median_iteration_ms, r.spread.map(|s| (s.repetitions, s.median_iteration_ms)), 3),
+            sort_value(r.peak_memory_mib),
+            number(r.peak_memory_mib, 0),
+        );
+        for spec in &METRICS {
+            let value = r.quality.get(spec.metric);
+            let _ = write!(
+                page,
+                "<td data-v=\"{}\">{}</td>",
+                value.map_or(String::new(), sort_value),
+                escape(&spec.format.apply(value))
+            );
+        }
+        let _ = writeln!(
+            page,
+            "<td>{}</td></tr>",
+            r.self_intersecting.map_or("not checked", |b| if b { "yes" } else { "no" }),
+        );
+    }
+    page.push_str("</tbody></table></div>\n");
+    page.push_str(concat!(
+        "<div id=\"viewer\" hidden><p><b id=\"viewer-title\"></b> &mdash; drag to turn, wheel to zoom ",
+        "<button id=\"viewer-reset\">reset</button> colour <select id=\"viewer-colour\">",
+        "<option value=\"shaded\">shaded: fixed blue, handles red</option>",
+        "<option value=\"angle\">angle error, 0&ndash;10&deg;</option>",
+        "<option value=\"area\">area distortion, &times;0.5 blue to &times;2 red</option></select> ",
+        "left <select id=\"viewer-left\"></select> <button id=\"viewer-close\">close</button></p>",
+        "<canvas id=\"viewer-left-canvas\" width=\"640\" height=\"520\"></canvas>",
+        "<canvas id=\"viewer-right-canvas\" width=\"640\" height=\"520\"></canvas></div>\n"
+    ));
+    page.push_str("<h2 id=\"measures\">What the columns mean</h2>\n<p>Every measure compares the result with the rest mesh:</p>\n");
     page.push_str("<dl class=\"metrics\">\n");
     for spec in &METRICS {
         let unit = if spec.unit.is_empty() { String::new() } else { format!(" ({})", spec.unit) };
@@ -92,82 +232,6 @@ pub fn render_index(
         }
         page.push_str("</ul>\n");
     }
-    page.push_str("<h2 id=\"verdict\">Quality regression gate</h2>\n");
-    match gate {
-        GateOutcome::Checked { baseline, findings } => {
-            let regressions = gate.regressions();
-            let name = escape(&baseline.display().to_string());
-            if regressions == 0 {
-                let _ = writeln!(page, "<p class=\"pass\">No regression against <code>{name}</code>.</p>");
-            } else {
-                let _ = writeln!(
-                    page,
-                    "<p class=\"fail\">{regressions} regression(s) against <code>{name}</code>:</p>"
-                );
-            }
-            if !findings.is_empty() {
-                page.push_str("<ul>\n");
-                for f in findings {
-                    let _ = writeln!(page, "<li>{}</li>", escape(&f.to_string()));
-                }
-                page.push_str("</ul>\n");
-            }
-        }
-        GateOutcome::NotChecked(reason) => {
-            let _ = writeln!(page, "<p>Not checked: {}</p>", escape(reason));
-        }
-    }
-
-    page.push_str(
-        "<h2 id=\"results\">Results</h2>\n<div class=\"scroll\"><table>\n<tr><th>scenario</th><th>method</th>\
-         <th>status</th><th>#V</th>\
-         <th>iterations</th><th>converged</th><th title=\"an external method's process start-up, not part of precompute\">startup</th><th>precompute</th><th>bind</th><th>solve</th><th>total</th>\
-         <th>iteration (ms)</th><th title=\"what the method added to the resident memory at its peak (one case at a time only)\">peak memory (MiB)</th>",
-    );
-    for spec in &METRICS {
-        let _ = write!(page, "<th title=\"{}\">{}</th>", escape(spec.doc), escape(spec.label));
-    }
-    page.push_str("<th>self-intersecting (open3d)</th></tr>\n");
-    for r in results {
-        let (class, badge) = match r.origin {
-            Origin::BuiltIn => (r.status.kind().to_string(), String::new()),
-            other => (
-                format!("{} {}", r.status.kind(), other.label()),
-                format!(
-                    "<span class=\"origin\" title=\"{}\">{}</span>",
-                    escape(r.about.as_deref().unwrap_or("")),
-                    other.label()
-                ),
-            ),
-        };
-        let _ = write!(
-            page,
-            "<tr class=\"{class}\"><td class=\"text\">{}</td><td class=\"text\">{}{badge}</td><td class=\"text status\">{}</td>\
-             <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>",
-            escape(&r.scenario),
-            escape(&r.method),
-            escape(&r.status.to_string()),
-            r.vertices,
-            r.iterations,
-            if r.converged { "yes" } else { "no" },
-            timing(r.startup_s, r.spread.map(|s| (s.repetitions, s.startup_s)), 3),
-            timing(r.precompute_s, r.spread.map(|s| (s.repetitions, s.precompute_s)), 3),
-            timing(r.bind_s, r.spread.map(|s| (s.repetitions, s.bind_s)), 4),
-            timing(r.solve_s, r.spread.map(|s| (s.repetitions, s.solve_s)), 3),
-            timing(r.total_s, r.spread.map(|s| (s.repetitions, s.total_s)), 3),
-            timing(r.median_iteration_ms, r.spread.map(|s| (s.repetitions, s.median_iteration_ms)), 3),
-            number(r.peak_memory_mib, 0),
-        );
-        for spec in &METRICS {
-            let _ = write!(page, "<td>{}</td>", escape(&spec.format.apply(r.quality.get(spec.metric))));
-        }
-        let _ = writeln!(
-            page,
-            "<td>{}</td></tr>",
-            r.self_intersecting.map_or("not checked", |b| if b { "yes" } else { "no" }),
-        );
-    }
-    page.push_str("</table></div>\n");
     if !peers.is_empty() {
         page.push_str("<h2 id=\"arap-libigl\">Our arap against libigl's</h2>\n");
         page.push_str(&markdown_table(&peers));
@@ -220,6 +284,10 @@ pub fn render_index(
         }
         page.push_str("</details>\n");
     }
+    page.push_str("<script>\n");
+    page.push_str(include_str!("page.js"));
+    page.push_str(include_str!("viewer.js"));
+    page.push_str("</script>\n");
     page.push_str(concat!(
         "<p id=\"image-check\" data-loaded=\"\" data-total=\"\"></p>\n",
         "<script>\n",
@@ -278,9 +346,10 @@ fn quality_against_time(page: &mut String, results: &[CaseResult], plots: &[&Pat
     }
 }
 
-/// A timing cell: the value, and below it the min–max range when it is a median of repetitions.
+/// A timing cell (`<td>`, sorted by its value): the value, and below it the min–max range when it
+/// is a median of repetitions.
 fn timing(value: f64, spread: Option<(usize, crate::case::Spread)>, digits: usize) -> String {
-    match spread {
+    let text = match spread {
         Some((n, s)) if n > 1 => format!(
             "{}<br><small title=\"min–max over {n} repetitions\">{}–{}</small>",
             number(value, digits),
@@ -288,7 +357,38 @@ fn timing(value: f64, spread: Option<(usize, crate::case::Spread)>, digits: usiz
             number(s.max, digits)
         ),
         _ => number(value, digits),
+    };
+    format!("<td data-v=\"{}\">{text}</td>", sort_value(value))
+}
+
+/// A cell's value for sorting (`data-v`): the number in full, empty when not finite.
+fn sort_value(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:e}")
+    } else {
+        String::new()
     }
+}
+
+/// How a measure is better, for the page script's ranking (`data-better`).
+fn better_word(better: crate::metrics::Better) -> &'static str {
+    match better {
+        crate::metrics::Better::Lower => "lower",
+        crate::metrics::Better::NearZero => "near-zero",
+    }
+}
+
+/// "Which method": per test the methods ranked by a measure the reader picks, with their verdicts
+/// and time per edit, and each method's median rank across the tests; the page script fills it
+/// from the results table (`page.js`).
+fn answer_first(page: &mut String) {
+    page.push_str(
+        "<h2 id=\"answer\">Which method</h2>\n<p>Rank by <select id=\"rank-by\"></select>: per test, the \
+         finished cases from best to worst (colour: the verdict; suspect ones count, marked), with the time \
+         per edit (bind + solve); then each method's median rank over the tests it ran on. Sort and filter \
+         the full table below, and click a row to turn its result in 3D; the address keeps the choice (<code>?rank=e_phi_deg&amp;sort=total_s&amp;status=ok</code>).</p>\n\
+         <div id=\"ranking\"></div>\n",
+    );
 }
 
 /// A path relative to the report directory as a URL path (forward slashes).

@@ -10,6 +10,7 @@ pub mod quality_time;
 pub mod render;
 pub mod run_comparison;
 pub mod tables;
+pub mod viewer;
 
 pub use tables::*;
 
