@@ -64,7 +64,7 @@ pub fn render_index(
         "#viewer canvas{border:1px solid #ccc;margin-right:8px;max-width:48%}\n",
         "th.sortable{cursor:pointer}th.sorted-up::after{content:' ▲'}th.sorted-down::after{content:' ▼'}\n",
         "#filters label{margin-right:1em;font-size:14px}#row-count{font-size:13px;color:#555}\n",
-        "div.ranking-grid{display:flex;flex-wrap:wrap;gap:1em}table.ranking{margin:0}\n",
+        "div.ranking-grid{display:flex;flex-wrap:wrap;gap:1em;align-items:flex-start}table.ranking{margin:0}\n",
         "table.ranking caption,#median-ranks caption{font-weight:bold;text-align:left}\n",
         "table.ranking tr.ok td{background:#e6f5e6}\n",
         "</style>\n</head>\n<body>\n",
