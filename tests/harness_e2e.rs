@@ -1280,7 +1280,8 @@ fn a_case_stopped_at_its_cap_is_unfinished_and_the_gate_sees_it() {
     );
     let page = std::fs::read_to_string(work.path().join("second/index.html")).unwrap();
     assert!(
-        page.contains("<tr class=\"unfinished\">") && page.contains("turned unfinished: bar / laplacian")
+        page.contains("<tr class=\"unfinished\" data-scenario=\"bar\" data-method=\"laplacian\"")
+            && page.contains("turned unfinished: bar / laplacian")
     );
     assert_eq!(
         run(&["check", "--reports", &second, "--baseline", &baseline]).unwrap(),

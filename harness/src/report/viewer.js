@@ -43,6 +43,19 @@
     if (!d.decoded[key]) d.decoded[key] = new Type(bytes(d[key]));
     return d.decoded[key];
   }
+  // The file's positions: u16 per coordinate between its lo and hi corners (report/viewer.rs).
+  function positionsOf(name) {
+    var d = data[name];
+    if (!d.positionsF32) {
+      var q = decoded(name, 'positions', Uint16Array), p = new Float32Array(q.length);
+      for (var i = 0; i < q.length; i++) {
+        var k = i % 3;
+        p[i] = d.lo[k] + (d.hi[k] - d.lo[k]) * q[i] / 65535;
+      }
+      d.positionsF32 = p;
+    }
+    return d.positionsF32;
+  }
 
   // Per face: its three corner angles (radians) and its area, of positions p on triangles t.
   function faceGeometry(p, t) {
@@ -158,9 +171,9 @@
   function restMesh(name) {
     var d = data[name];
     if (!d.mesh) {
-      var p = decoded(name, 'positions', Float32Array), lo = [1e30, 1e30, 1e30], hi = [-1e30, -1e30, -1e30];
+      var p = positionsOf(name), lo = [1e30, 1e30, 1e30], hi = [-1e30, -1e30, -1e30];
       for (var i = 0; i < p.length; i++) { lo[i % 3] = Math.min(lo[i % 3], p[i]); hi[i % 3] = Math.max(hi[i % 3], p[i]); }
-      var t = decoded(name, 'triangles', Uint32Array);
+      var t = decoded(name, 'triangles', d.index_bytes === 2 ? Uint16Array : Uint32Array);
       d.mesh = {
         positions: p, triangles: t, roles: decoded(name, 'roles', Uint8Array),
         center: [0, 1, 2].map(function (k) { return (lo[k] + hi[k]) / 2; }),
@@ -191,8 +204,8 @@
         var finish = function () {
           shown = {
             rest: restMesh(restName),
-            right: { method: row.dataset.method, positions: decoded(row.dataset.view, 'positions', Float32Array) },
-            left: left ? { method: left.dataset.method, positions: decoded(left.dataset.view, 'positions', Float32Array) } : null
+            right: { method: row.dataset.method, positions: positionsOf(row.dataset.view) },
+            left: left ? { method: left.dataset.method, positions: positionsOf(left.dataset.view) } : null
           };
           if (box.dataset.rest !== restName) camera = { yaw: 0.6, pitch: shown.rest.pitch, zoom: 1 };
           box.dataset.rest = restName;

@@ -1,11 +1,14 @@
 //! The page's 3D view reads its meshes from small script files under `viewer/`, one per test's rest
 //! mesh and one per case's result, loaded only when a case is opened: a page opened from disk may not
 //! fetch files, but it may add a `<script src>`. Each file calls `deformbenchViewerData(name, data)`
-//! with base64 little-endian arrays:
-//! - `viewer/<test>.rest.js`: `positions` (`#V x 3` f32), `triangles` (`#F x 3` u32), `roles`
-//!   (`#V` u8: 0 free, 1 fixed, 2 handle, from the first edit step's regions);
-//! - `viewer/<test>-<method>.js`: `positions` of the result (`#V x 3` f32), on the rest mesh's
-//!   vertices.
+//! with base64 little-endian arrays, kept small because a report holds one per case (the survey
+//! run's `reports/` stays under 50 MB):
+//! - `positions`: `#V x 3` u16, each coordinate quantized between the file's `lo` and `hi` corners
+//!   (2^-16 of the extent: a few thousandths of a face's size on the survey meshes, far below what the view's
+//!   colours resolve);
+//! - `viewer/<test>.rest.js`: `positions`, `triangles` (`#F x 3`, u16 when `index_bytes` is 2,
+//!   else u32), `roles` (`#V` u8: 0 free, 1 fixed, 2 handle, from the first edit step's regions);
+//! - `viewer/<test>-<method>.js`: the result's `positions`, on the rest mesh's vertices.
 
 use std::path::Path;
 
@@ -16,13 +19,34 @@ use crate::scenario::{LoadedScenario, Role};
 /// Where the viewer's files go, relative to the report directory.
 pub const VIEWER_DIR: &str = "viewer";
 
-fn f32_base64(positions: &[[f64; 3]]) -> String {
-    let bytes: Vec<u8> = positions.iter().flatten().flat_map(|v| (*v as f32).to_le_bytes()).collect();
-    base64::encode(bytes)
+/// The `positions`, `lo` and `hi` fields of `positions` quantized to u16 per coordinate.
+fn quantized(positions: &[[f64; 3]]) -> Vec<(&'static str, String)> {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let bytes: Vec<u8> = positions
+        .iter()
+        .flat_map(|p| {
+            (0..3).map(move |k| {
+                let extent = hi[k] - lo[k];
+                let t = if extent > 0.0 { (p[k] - lo[k]) / extent } else { 0.0 };
+                (t * 65535.0).round() as u16
+            })
+        })
+        .flat_map(u16::to_le_bytes)
+        .collect();
+    let json = |v: [f64; 3]| serde_json::to_string(&v).expect("finite corners");
+    vec![("positions", format!("\"{}\"", base64::encode(bytes))), ("lo", json(lo)), ("hi", json(hi))]
 }
 
+/// `deformbenchViewerData("name",{"key":value,…});` with each value already JSON.
 fn script(name: &str, fields: &[(&str, String)]) -> String {
-    let body = fields.iter().map(|(k, v)| format!("\"{k}\":\"{v}\"")).collect::<Vec<_>>().join(",");
+    let body = fields.iter().map(|(k, v)| format!("\"{k}\":{v}")).collect::<Vec<_>>().join(",");
     format!("deformbenchViewerData({},{{{body}}});\n", serde_json::Value::String(name.to_string()))
 }
 
@@ -55,21 +79,24 @@ pub fn write_viewer_data(
                 };
             }
         }
-        let triangles: Vec<u8> = mesh.triangles().iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+        let short = mesh.n_vertices() <= u16::MAX as usize;
+        let triangles: Vec<u8> = mesh
+            .triangles()
+            .iter()
+            .flatten()
+            .flat_map(|&i| if short { (i as u16).to_le_bytes().to_vec() } else { i.to_le_bytes().to_vec() })
+            .collect();
         let rest_name = crate::report::file_name(&scenario.spec.name);
-        let text = script(
-            &format!("{rest_name}.rest"),
-            &[
-                ("positions", f32_base64(mesh.positions())),
-                ("triangles", base64::encode(triangles)),
-                ("roles", base64::encode(&roles)),
-            ],
-        );
+        let mut fields = quantized(mesh.positions());
+        fields.push(("triangles", format!("\"{}\"", base64::encode(triangles))));
+        fields.push(("index_bytes", if short { "2" } else { "4" }.to_string()));
+        fields.push(("roles", format!("\"{}\"", base64::encode(&roles))));
+        let text = script(&format!("{rest_name}.rest"), &fields);
         write(&out.join(format!("{rest_name}.rest.js")), &text)?;
         for case in cases {
             let stem = crate::report::case_file_stem(&case.scenario, &case.method);
             let positions = case.positions.as_ref().expect("filtered");
-            write(&out.join(format!("{stem}.js")), &script(&stem, &[("positions", f32_base64(positions))]))?;
+            write(&out.join(format!("{stem}.js")), &script(&stem, &quantized(positions)))?;
             written.push(stem);
         }
     }

@@ -247,6 +247,7 @@ const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
 const CHUNK_JSON: u32 = 0x4E4F_534A; // "JSON"
 const CHUNK_BIN: u32 = 0x004E_4942; // "BIN\0"
 const FLOAT: u32 = 5126;
+const UNSIGNED_SHORT: u32 = 5123;
 const UNSIGNED_INT: u32 = 5125;
 const ARRAY_BUFFER: u32 = 34962;
 const ELEMENT_ARRAY_BUFFER: u32 = 34963;
@@ -258,7 +259,8 @@ const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 ///   ([`crate::geometry::vertex_normals`]); a vertex without one (isolated, or only on zero-area faces)
 ///   gets `+z`, since glTF requires unit normals;
 /// - `COLOR_0`: `#V` float32 VEC3 linear RGB in `[0, 1]`, when `colors` is given;
-/// - indices: `#F x 3` uint32 SCALAR.
+/// - indices: `#F x 3` SCALAR, uint16 when every index fits (at most 65,535 vertices: half the
+///   bytes, for the survey-sized meshes a report writes by the dozen), else uint32.
 ///
 /// Errors: [`MeshError::LengthMismatch`] when `colors` does not have `#V` entries;
 /// [`MeshError::Invalid`] for a color outside `[0, 1]` (or NaN), a coordinate beyond the `f32` range,
@@ -309,23 +311,29 @@ pub fn encode_glb(mesh: &TriMesh, colors: Option<&[[f32; 3]]>) -> Result<Vec<u8>
         }
     }
     let indices_offset = bin.len();
+    let short = nv <= u16::MAX as usize;
     for t in mesh.triangles() {
-        for i in t {
-            bin.extend_from_slice(&i.to_le_bytes());
+        for &i in t {
+            if short {
+                bin.extend_from_slice(&(i as u16).to_le_bytes());
+            } else {
+                bin.extend_from_slice(&i.to_le_bytes());
+            }
         }
     }
+    let (index_type, index_bytes) = if short { (UNSIGNED_SHORT, 6 * nf) } else { (UNSIGNED_INT, 12 * nf) };
     let vec3_bytes = 12 * nv;
 
     let mut attributes = json!({ "POSITION": 0, "NORMAL": 1 });
     let mut views = vec![
         json!({ "buffer": 0, "byteOffset": 0, "byteLength": vec3_bytes, "target": ARRAY_BUFFER }),
         json!({ "buffer": 0, "byteOffset": normals_offset, "byteLength": vec3_bytes, "target": ARRAY_BUFFER }),
-        json!({ "buffer": 0, "byteOffset": indices_offset, "byteLength": 12 * nf, "target": ELEMENT_ARRAY_BUFFER }),
+        json!({ "buffer": 0, "byteOffset": indices_offset, "byteLength": index_bytes, "target": ELEMENT_ARRAY_BUFFER }),
     ];
     let mut accessors = vec![
         json!({ "bufferView": 0, "componentType": FLOAT, "count": nv, "type": "VEC3", "min": lo, "max": hi }),
         json!({ "bufferView": 1, "componentType": FLOAT, "count": nv, "type": "VEC3" }),
-        json!({ "bufferView": 2, "componentType": UNSIGNED_INT, "count": 3 * nf, "type": "SCALAR" }),
+        json!({ "bufferView": 2, "componentType": index_type, "count": 3 * nf, "type": "SCALAR" }),
     ];
     if colors.is_some() {
         attributes["COLOR_0"] = json!(3);
