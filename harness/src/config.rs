@@ -281,8 +281,7 @@ impl MethodCatalog {
             m.sweeps.retain(|p| p.sweep != name);
         }
         for (position, point) in points.iter().enumerate() {
-            let params = point.apply(&base.params);
-            let params = sweep::Point { values: shared.clone().into_iter().collect() }.apply(&params);
+            let params = sweep::laid_over(&point.apply(&base.params), &shared);
             let here = SweepPosition { sweep: name.to_string(), position, values: point.values_text() };
             if params == base.params {
                 self.methods.iter_mut().find(|m| m.name == base.name).expect("the base").sweeps.push(here);
@@ -420,9 +419,7 @@ fn entry(
         let summary = summary.unwrap_or_else(|| format!("`{base}` with {params}").replace('\n', ", "));
         // The base method as configured, with the variant's own values.
         let params = match catalog.get(base) {
-            Some(configured) => {
-                sweep::Point { values: params.into_iter().collect() }.apply(&configured.params)
-            }
+            Some(configured) => sweep::laid_over(&configured.params, &params),
             None => params,
         };
         methods::registry::create(base, &params).map_err(|e| config(e.to_string()))?;

@@ -3,8 +3,8 @@
 //! each time per edit, the `ok` case with the lowest error within it).
 //!
 //! Time is the time to a result after a handle edit, bind + solve ([`TimeAxis::Edit`]), or the
-//! same with the precompute ([`TimeAxis::WithPrecompute`]); an external method's start-up is left
-//! out of both, as it is of `total_s`'s comparisons.
+//! same with the precompute ([`TimeAxis::WithPrecompute`]); an external method's process start-up
+//! is left out of both, as it is out of `precompute_s`.
 
 use crate::case::CaseResult;
 use crate::metrics::Metric;

@@ -170,14 +170,7 @@ pub fn publish(
     let viewable = report::viewer::write_viewer_data(dir, &run.results, &run.scenarios, |s| {
         publish.meshes.every_scenario || s.spec.writes_result_meshes()
     })?;
-    let quality_time = report::quality_time::render_markdown(&run.results);
-    if !quality_time.is_empty() {
-        let path = dir.join("pareto.md");
-        meshes::io::atomic_write(&path, |w| {
-            w.write_all(format!("# Quality against time\n\n{quality_time}").as_bytes())
-                .map_err(meshes::MeshError::from)
-        })?;
-    }
+    report::quality_time::write_markdown(dir, &run.results)?;
     timed(RunPhase::Reports, start);
 
     let start = Instant::now();

@@ -65,7 +65,7 @@ pub fn estimated_cost(scenario: &LoadedScenario, methods: &[&str]) -> f64 {
     methods
         .iter()
         .map(|m| {
-            let base = m.split('[').next().unwrap_or(m);
+            let base = crate::sweep::base_method(m);
             SECONDS_PER_KILOVERTEX.iter().find(|(name, _)| *name == base).map_or(slowest, |(_, s)| *s)
         })
         .sum::<f64>()

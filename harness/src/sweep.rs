@@ -35,12 +35,25 @@ impl Point {
 
     /// `params` with this point's values set.
     pub fn apply(&self, params: &toml::Table) -> toml::Table {
-        let mut out = params.clone();
-        for (k, v) in &self.values {
-            out.insert(k.clone(), v.clone());
-        }
-        out
+        laid_over(params, self.values.iter().map(|(k, v)| (k, v)))
     }
+}
+
+/// `base` with `values` set: a variant's or a point's parameters over its base method's table.
+pub fn laid_over<'a>(
+    base: &toml::Table,
+    values: impl IntoIterator<Item = (&'a String, &'a toml::Value)>,
+) -> toml::Table {
+    let mut out = base.clone();
+    for (k, v) in values {
+        out.insert(k.clone(), v.clone());
+    }
+    out
+}
+
+/// The base method of a point's name (`isolines` of `isolines[isolines=10]`); any other name itself.
+pub fn base_method(name: &str) -> &str {
+    name.split('[').next().unwrap_or(name)
 }
 
 /// Whether `params` holds a sweep (some value is a list).

@@ -142,15 +142,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     PEAK.store(before, Ordering::Relaxed);
 
     let start = origin.elapsed().as_secs_f64();
-    let mut marks = vec![("start", start, IN_USE.load(Ordering::Relaxed))];
+    let in_use_at_start = IN_USE.load(Ordering::Relaxed);
     instance.precompute(&mesh)?;
     let precompute_end = origin.elapsed().as_secs_f64();
     let precompute_phases: Vec<(String, f64)> =
         instance.phase_timings().into_iter().filter(|(_, s)| *s > 0.0).collect();
     let precompute_peak = PEAK.load(Ordering::Relaxed);
-    marks.push(("bind", precompute_end, IN_USE.load(Ordering::Relaxed)));
+    let in_use_at_bind = IN_USE.load(Ordering::Relaxed);
     instance.bind_handles(&handles)?;
-    marks.push(("solve", origin.elapsed().as_secs_f64(), IN_USE.load(Ordering::Relaxed)));
+    let (bind_end, in_use_at_solve) = (origin.elapsed().as_secs_f64(), IN_USE.load(Ordering::Relaxed));
     let summary = instance.solve(&targets, &mut NoObserver)?;
     let end = origin.elapsed().as_secs_f64();
     let held = IN_USE.load(Ordering::Relaxed);
@@ -183,22 +183,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "{:<34} {:>9.2} {:>11.0} {:>9.0}  (exact)",
         "precompute",
         precompute_end - start,
-        mib(marks[0].2),
+        mib(in_use_at_start),
         mib(precompute_peak)
     );
-    let bind_end = marks[2].1;
     println!(
         "{:<34} {:>9.2} {:>11.0} {:>9.0}",
         "bind",
         bind_end - precompute_end,
-        mib(marks[1].2),
+        mib(in_use_at_bind),
         mib(most(precompute_end, bind_end))
     );
     println!(
         "{:<34} {:>9.2} {:>11.0} {:>9.0}  ({} iterations)",
         "solve",
         end - bind_end,
-        mib(marks[2].2),
+        mib(in_use_at_solve),
         mib(most(bind_end, end)),
         summary.iterations
     );

@@ -1,7 +1,10 @@
-//! `reports/index.html`: the results table, the regression verdict, HIRM's Table 1, the rendered
+//! `reports/index.html`: the provenance and regression verdict, "Which method" (a ranking per test),
+//! the results table, the 3D view of a case, quality against time, HIRM's Table 1, the rendered
 //! figures and every plot on one page that opens from disk (relative links only, no server, no
-//! external resources). A script at the end counts the images that loaded and writes the count into
-//! `#image-check` (`data-loaded` / `data-total` attributes), which the browser test reads.
+//! external resources). Its scripts (`page.js`: ranking, sorting, filtering, the address;
+//! `viewer.js`: the 3D view, whose meshes [`crate::report::viewer`] writes) are inlined. A script
+//! at the end counts the images that loaded and writes the count into `#image-check`
+//! (`data-loaded` / `data-total` attributes), which the browser test reads.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -27,7 +30,8 @@ fn number(v: f64, digits: usize) -> String {
 
 /// The page for `results` (with `data_source` and the run's `provenance` line), linking `images` (paths relative to the report
 /// directory: plots and figures) and showing `table1_markdown` (HIRM's Table 1 as written to
-/// `table1.md`) and `peers` (our ARAP against libigl's, `peers.md`; empty: none).
+/// `table1.md`) and `peers` (our ARAP against libigl's, `peers.md`; empty: none); the cases whose
+/// stems `viewable` names open in the 3D view.
 pub fn render_index(
     results: &[CaseResult],
     data_source: &str,

@@ -1,6 +1,7 @@
 //! Everything the harness writes for people to read: the result tables and meshes ([`tables`]),
-//! the plots ([`plots`]), quality against time with the budget tables ([`quality_time`]), our `arap` against libigl's ([`peer_comparison`]), two runs compared ([`run_comparison`]), the pictures ([`render`]), the HTML page ([`html`]) and the font they
-//! share ([`fonts`]). Each writer renders in memory first and writes its files atomically.
+//! the plots ([`plots`]), quality against time with the budget tables ([`quality_time`]), our `arap` against libigl's ([`peer_comparison`]), two runs compared
+//! ([`run_comparison`]), the pictures ([`render`]), the 3D view's mesh files ([`viewer`]), the HTML
+//! page ([`html`]) and the font they share ([`fonts`]). Each writer renders in memory first and writes its files atomically.
 
 pub mod fonts;
 pub mod html;

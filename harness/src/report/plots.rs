@@ -619,11 +619,6 @@ fn draw_table1<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult]) ->
     draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 14)
 }
 
-/// The base method of a sweep point (`isolines` of `isolines[isolines=10]`): its colour.
-fn base_method(method: &str) -> &str {
-    method.split('[').next().unwrap_or(method)
-}
-
 /// Quality against time for one scenario: a panel per measure of [`crate::pareto::MEASURES`] (rows)
 /// and time axis (columns).
 fn draw_pareto<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &[&CaseResult]) -> DrawResult {
@@ -700,7 +695,7 @@ fn draw_pareto_panel<DB: DrawingBackend>(
             .collect();
         line.sort_by_key(|(position, _, _)| *position);
         let Some((_, first, _)) = line.first() else { continue };
-        let color = method_color(base_method(&first.method), cases);
+        let color = method_color(crate::sweep::base_method(&first.method), cases);
         chart
             .draw_series(LineSeries::new(line.iter().map(|(_, _, p)| *p), color.mix(0.6).stroke_width(1)))
             .map_err(err)?;
@@ -723,7 +718,7 @@ fn draw_pareto_panel<DB: DrawingBackend>(
     // The points: one legend entry per base method.
     let mut labelled: Vec<&str> = Vec::new();
     for (c, p) in &placed {
-        let base = base_method(&c.method);
+        let base = crate::sweep::base_method(&c.method);
         let color = method_color(base, cases);
         let at = xy(p);
         let series = chart.draw_series(std::iter::once(Circle::new(at, 5, color.filled()))).map_err(err)?;

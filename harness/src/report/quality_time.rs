@@ -4,6 +4,7 @@
 //! edit, and every point with its parameters, times, measures and status.
 
 use std::fmt::Write as _;
+use std::path::Path;
 
 use crate::case::CaseResult;
 use crate::pareto::{best_within, budget_label, ok_front, points, TimeAxis, BUDGETS_S, MEASURES};
@@ -66,13 +67,21 @@ pub fn budget_table(cases: &[&CaseResult]) -> String {
     md.push('\n');
     md.push_str(&"|---".repeat(MEASURES.len() + 1));
     md.push_str("|\n");
-    for budget in BUDGETS_S {
-        let _ = write!(md, "| {} |", budget_label(budget));
-        for measure in MEASURES {
+    // Per measure: the placed cases, their points and which are `ok`.
+    let placed: Vec<_> = MEASURES
+        .iter()
+        .map(|&measure| {
             let placed = points(cases, TimeAxis::Edit, measure);
             let coordinates: Vec<_> = placed.iter().map(|(_, p)| *p).collect();
             let ok: Vec<bool> = placed.iter().map(|(c, _)| c.status.is_ok()).collect();
-            match best_within(&coordinates, &ok, budget) {
+            (measure, placed, coordinates, ok)
+        })
+        .collect();
+    for budget in BUDGETS_S {
+        let _ = write!(md, "| {} |", budget_label(budget));
+        for (measure, placed, coordinates, ok) in &placed {
+            let measure = *measure;
+            match best_within(coordinates, ok, budget) {
                 Some(i) => {
                     let _ = write!(
                         md,
@@ -152,4 +161,16 @@ pub fn render_markdown(results: &[CaseResult]) -> String {
         md.push('\n');
     }
     md
+}
+
+/// Write `pareto.md` under `dir` (atomically) when `results` have a swept test.
+pub fn write_markdown(dir: &Path, results: &[CaseResult]) -> Result<(), crate::error::HarnessError> {
+    let markdown = render_markdown(results);
+    if !markdown.is_empty() {
+        let text = format!("# Quality against time\n\n{markdown}");
+        meshes::io::atomic_write(dir.join("pareto.md"), |w| {
+            w.write_all(text.as_bytes()).map_err(meshes::MeshError::from)
+        })?;
+    }
+    Ok(())
 }

@@ -163,8 +163,13 @@
     if (!shown) return;
     var leftIsRest = !shown.left;
     var leftPositions = leftIsRest ? shown.rest.positions : shown.left.positions;
-    draw(canvases[0], leftPositions, faceColours(leftPositions, leftIsRest), leftIsRest ? 'rest' : shown.left.method);
-    draw(canvases[1], shown.right.positions, faceColours(shown.right.positions, false), shown.right.method);
+    // Colours change with the colouring, not with the camera: computed once per choice.
+    if (shown.colouredBy !== colourBy.value) {
+      shown.colours = [faceColours(leftPositions, leftIsRest), faceColours(shown.right.positions, false)];
+      shown.colouredBy = colourBy.value;
+    }
+    draw(canvases[0], leftPositions, shown.colours[0], leftIsRest ? 'rest' : shown.left.method);
+    draw(canvases[1], shown.right.positions, shown.colours[1], shown.right.method);
     box.dataset.pixels = Math.min(drawnPixels(canvases[0]), drawnPixels(canvases[1]));
   }
 

@@ -21,14 +21,7 @@ pub const VIEWER_DIR: &str = "viewer";
 
 /// The `positions`, `lo` and `hi` fields of `positions` quantized to u16 per coordinate.
 fn quantized(positions: &[[f64; 3]]) -> Vec<(&'static str, String)> {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in positions {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = meshes::geometry::bbox(positions);
     let bytes: Vec<u8> = positions
         .iter()
         .flat_map(|p| {
@@ -40,7 +33,8 @@ fn quantized(positions: &[[f64; 3]]) -> Vec<(&'static str, String)> {
         })
         .flat_map(u16::to_le_bytes)
         .collect();
-    let json = |v: [f64; 3]| serde_json::to_string(&v).expect("finite corners");
+    // serde_json writes a non-finite corner as null, never an error.
+    let json = |v: [f64; 3]| serde_json::to_string(&v).expect("an array of numbers");
     vec![("positions", format!("\"{}\"", base64::encode(bytes))), ("lo", json(lo)), ("hi", json(hi))]
 }
 
