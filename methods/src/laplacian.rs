@@ -11,9 +11,9 @@
 //!   everything `L` does: the rest coordinates `delta = L X_rest`, the normal matrix `L^T L` and the
 //!   right-hand side `L^T delta(X)`; the rest shape stays a fixed point for any weights since both
 //!   sides use the same `L`.
-//! - `delta(X)` update: the rest Laplacian coordinates `delta_i = (L X_rest)_i` turned by the
-//!   rotation each vertex's one-ring made from the rest shape (Procrustes fit,
-//!   [`crate::laplacian_coordinates`], where the choice and the one it replaced are written down).
+//! - `delta(X)` update: the rest Laplacian coordinates `delta_i = (L X_rest)_i` turned with the
+//!   surface, in Lipman et al. 2005's local frames by default (`delta_frame`,
+//!   [`crate::laplacian_coordinates`], where both frames and why each is used are written down).
 //!   The rest shape is a fixed point.
 //! - `X^0` is the current shape (eq 3: "the current edited vertex positions"); from the rest shape
 //!   iteration 0 therefore solves with the un-rotated `delta`, i.e. linear Laplacian editing
@@ -37,7 +37,7 @@ use serde::Deserialize;
 
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
-use crate::laplacian_coordinates::RotationInvariantCoordinates;
+use crate::laplacian_coordinates::{DeltaFrame, RotationInvariantCoordinates};
 use crate::linalg::anderson::{Acceleration, FixedPointIteration, MAX_DEPTH};
 use crate::linalg::sparse_cholesky::{add_to_diagonal, SparseCholesky};
 use crate::method::{
@@ -61,6 +61,8 @@ pub struct LaplacianParams {
     pub acceleration: Acceleration,
     /// Steps of history Anderson acceleration extrapolates from (at most 16).
     pub anderson_depth: usize,
+    /// How `delta(X)` turns with the surface ([`DeltaFrame`]).
+    pub delta_frame: DeltaFrame,
 }
 
 impl Default for LaplacianParams {
@@ -72,6 +74,7 @@ impl Default for LaplacianParams {
             weights: LaplacianWeights::default(),
             acceleration: Acceleration::default(),
             anderson_depth: 5,
+            delta_frame: DeltaFrame::default(),
         }
     }
 }
@@ -156,7 +159,13 @@ impl DeformationMethod for LaplacianEditing {
         let normal_matrix = sorted(&product);
         self.cholesky = Some(SparseCholesky::analyze(normal_matrix.as_ref())?);
 
-        let coordinates = RotationInvariantCoordinates::new(positions, &topology, laplacian.as_ref());
+        let coordinates = RotationInvariantCoordinates::new(
+            positions,
+            rest_mesh.triangles(),
+            &topology,
+            laplacian.as_ref(),
+            self.params.delta_frame,
+        );
         self.rest = Some(RestState {
             laplacian,
             normal_matrix,

@@ -10,7 +10,7 @@ pub mod isoline_model;
 pub mod isolines;
 pub mod keys;
 pub mod laplacian;
-mod laplacian_coordinates;
+pub mod laplacian_coordinates;
 pub mod linalg;
 pub mod method;
 pub mod operators;

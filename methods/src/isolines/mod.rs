@@ -64,7 +64,7 @@ use crate::isoline_model::{
     checked_positions, reduced_step, IsolineModel, ModelFrame, ReducedFixedPoint, ReducedIteration,
     ReducedSystem, RotationFit, SetBlend,
 };
-use crate::laplacian_coordinates::RotationInvariantCoordinates;
+use crate::laplacian_coordinates::{DeltaFrame, RotationInvariantCoordinates};
 use crate::linalg::anderson::{Acceleration, MAX_DEPTH};
 use crate::method::{run_iterations, DeformationMethod, IterationObserver, Iterations, SolveSummary};
 use crate::operators::{laplacian, LaplacianWeights};
@@ -106,6 +106,8 @@ pub struct IsolinesParams {
     pub acceleration: Acceleration,
     /// Steps of history Anderson acceleration extrapolates from (at most 16).
     pub anderson_depth: usize,
+    /// How `delta(X)` turns with the surface in the `vertices` variant ([`DeltaFrame`]).
+    pub delta_frame: DeltaFrame,
 }
 
 impl Default for IsolinesParams {
@@ -121,6 +123,7 @@ impl Default for IsolinesParams {
             weights: LaplacianWeights::default(),
             acceleration: Acceleration::default(),
             anderson_depth: 5,
+            delta_frame: DeltaFrame::default(),
         }
     }
 }
@@ -259,7 +262,13 @@ impl DeformationMethod for Isolines {
             MethodError::Solver(crate::linalg::sparse_cholesky::SolverError::NotPositiveDefinite)
         })?;
         let coordinates = (self.params.laplacian_coordinates == LaplacianCoordinates::Vertices).then(|| {
-            RotationInvariantCoordinates::new(&self.current, &rest.topology, rest.laplacian.as_ref())
+            RotationInvariantCoordinates::new(
+                &self.current,
+                &rest.triangles,
+                &rest.topology,
+                rest.laplacian.as_ref(),
+                self.params.delta_frame,
+            )
         });
         let t3 = Instant::now();
         self.reduced = model.identity_transforms();

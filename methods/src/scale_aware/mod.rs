@@ -73,6 +73,7 @@ pub use vertex_recovery::{RecoveryTimings, VertexRecovery};
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
 use crate::laplacian::{LaplacianEditing, LaplacianParams};
+use crate::laplacian_coordinates::DeltaFrame;
 use crate::method::{
     max_displacement, move_to, run_iterations, DeformationMethod, IterationObserver, IterationReport,
     Iterations, NoObserver, SolveSummary,
@@ -200,6 +201,9 @@ impl ScaleAware {
             weights: params.weights,
             max_iterations: 1,
             tolerance: 0.0,
+            // From the rest shape any frame gives delta_bar (R = I); from an earlier edit's result
+            // (incremental scenarios) the frame matters, and its baselines were measured with this one.
+            delta_frame: DeltaFrame::OneRing,
             ..LaplacianParams::default()
         })?;
         Ok(Self {
