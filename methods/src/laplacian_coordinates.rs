@@ -18,12 +18,14 @@
 //! Why both (issue 35, measured; see configs/methods.toml): the one edge of Lipman's frame turns
 //! with every small move of its two vertices, and on the 43K armadillo `isolines_t1` never settled
 //! with it (steps of ~2e-3 of the diagonal to its cap, a collapsed torso), while the fitted
-//! rotation averages the whole one-ring and converges there. But the fit reads the vertex's own
-//! position in every spoke `x_i - x_j`: where `delta_bar_i` is large against the spokes (the rim of
-//! an open scan, where it points across the boundary), moving `x_i` turns `R_i` and so `delta_i`,
-//! which moves `x_i` again; unreduced `laplacian` crumples open scans this way (folded interior
-//! edges along the boundary, unfinished at its cap), where Lipman's frame does not. The reduced
-//! `isolines_t1` cannot move single vertices, so it does not meet that loop.
+//! rotation averages the whole one-ring and converges there. But unreduced `laplacian` with the
+//! fit crumples open scans (the dataset's face, mountain and africanhead: stopped at the 2000 cap,
+//! steps 1e-2 to 3e-2 of the diagonal, 0.1-0.5% folded edges) where Lipman's frames converge in
+//! 64-224 iterations. A likely loop: the fit reads the vertex's own position in every spoke
+//! `x_i - x_j`, so a move of `x_i` turns `R_i` and with it `delta_i`, which moves `x_i` again;
+//! Lipman's normal averages the faces around `x_i` and barely turns when it moves. The reduced
+//! `isolines_t1` moves no single vertex on its own, and on the same open scans both frames give it
+//! the same result.
 //!
 //! Iterative Laplacian editing can have several fixed points where a free limb may swing, and
 //! which one the iteration finds depends on `delta`'s encoding and on the path. Measured on the
