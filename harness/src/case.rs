@@ -7,9 +7,11 @@ use methods::{IterationObserver, IterationReport};
 use serde::{Deserialize, Serialize};
 
 use crate::config::{ConfiguredMethod, Origin};
-use crate::metrics::{angle_errors, largest_displacement, Evaluation, Metric, Quality, RestGeometry};
+use crate::metrics::{
+    angle_errors, asked_turn, largest_displacement, Bends, Evaluation, Metric, Quality, RestGeometry,
+};
 use crate::scenario::LoadedScenario;
-use crate::verdict::{Status, Unfinished, VerdictRules};
+use crate::verdict::{Motion, Status, Unfinished, VerdictRules};
 
 /// One iteration as recorded for convergence curves.
 #[derive(Clone, Copy, Debug, Serialize, Deserialize)]
@@ -380,8 +382,9 @@ impl IterationObserver for Recorder<'_> {
 pub enum Reference<'a> {
     /// This case is the reference (its distances are 0).
     Itself,
-    /// The reference's `#V x 3` result on the same scenario.
-    Of(&'a [[f64; 3]]),
+    /// The reference's `#V x 3` result on the same scenario, and whether it finished (ok or
+    /// suspect: not an iterate stopped at its cap).
+    Of { positions: &'a [[f64; 3]], finished: bool },
     /// No reference result (not run, or failed).
     Missing,
 }
@@ -493,10 +496,11 @@ pub fn run_case(
             return Err(methods::MethodError::NonFiniteResult { method: m.name().to_string(), vertex: v });
         }
         let evaluation_start = Instant::now();
-        let reference = match reference {
-            Reference::Itself => Some(&positions[..]),
-            Reference::Of(r) => Some(r),
-            Reference::Missing => None,
+        let (reference, reference_finished) = match reference {
+            // Its own verdict does not wait for itself; its turn against itself is 0.
+            Reference::Itself => (Some(&positions[..]), true),
+            Reference::Of { positions, finished } => (Some(positions), finished),
+            Reference::Missing => (None, false),
         };
         result.quality = Quality::evaluate(&Evaluation::new(
             rest,
@@ -509,11 +513,14 @@ pub fn run_case(
         result.largest_move_over_diag =
             largest_displacement(scenario.mesh.positions(), &positions) / rest.diagonal;
         result.largest_handle_move_over_diag = largest_handle_move / rest.diagonal;
-        let reasons = rules.reasons(
-            &result.quality,
-            result.largest_move_over_diag,
-            result.largest_handle_move_over_diag,
-        );
+        let motion = Motion {
+            largest_move: result.largest_move_over_diag,
+            largest_handle_move: result.largest_handle_move_over_diag,
+            asked_turn_deg: asked_turn(scenario.mesh.positions(), &step.handles, &targets, Bends::FromHeld)
+                .to_degrees(),
+            reference_finished,
+        };
+        let reasons = rules.reasons(&result.quality, motion);
         result.positions = Some(positions);
         result.overhead.evaluation_s = evaluation_start.elapsed().as_secs_f64();
         Ok(reasons)

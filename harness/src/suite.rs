@@ -404,7 +404,10 @@ impl SharedCases<'_> {
         }
         let reference = if self.plans_reference[s] {
             let r = self.references[s].get_or_init(|| self.run_case(s, REFERENCE_METHOD, Reference::Itself));
-            r.positions.as_deref().map_or(Reference::Missing, Reference::Of)
+            let finished = r.status.is_ok() || r.status.is_suspect();
+            r.positions
+                .as_deref()
+                .map_or(Reference::Missing, |positions| Reference::Of { positions, finished })
         } else {
             Reference::Missing
         };

@@ -28,6 +28,28 @@ pub struct VerdictRules {
     pub frame_margin_diagonals: f64,
     /// Largest `turn_beyond_handles_deg` (degrees) that is still `ok`.
     pub max_turn_beyond_handles_deg: f64,
+    /// Largest `turn_to_arap_deg` that is still `ok`, as a fraction of the turn the handles ask
+    /// (judged where the reference finished) ...
+    pub max_turn_to_arap_of_asked: f64,
+    /// ... but never below this many degrees.
+    pub min_turn_to_arap_allowed_deg: f64,
+}
+
+/// What a verdict reads of a case besides its measures.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Motion {
+    /// The largest distance of any result vertex from its rest position, over the rest diagonal.
+    pub largest_move: f64,
+    /// The largest distance of a handle target from its vertex's rest position (over every edit
+    /// step), over the rest diagonal.
+    pub largest_handle_move: f64,
+    /// The turn the last step's handles ask of the free surface (degrees,
+    /// [`crate::metrics::asked_turn`] with bends from the held regions only).
+    pub asked_turn_deg: f64,
+    /// The scenario's reference (`arap`) finished (ok or suspect), so its result judges this one's
+    /// turns (`turn_to_arap_deg`); an unfinished reference is an iterate, and then only the result's
+    /// own measures judge it (`turn_beyond_handles_deg` among them).
+    pub reference_finished: bool,
 }
 
 impl VerdictRules {
@@ -42,6 +64,8 @@ impl VerdictRules {
             ("max_handle_residual_over_diag", rules.max_handle_residual_over_diag),
             ("frame_margin_diagonals", rules.frame_margin_diagonals),
             ("max_turn_beyond_handles_deg", rules.max_turn_beyond_handles_deg),
+            ("max_turn_to_arap_of_asked", rules.max_turn_to_arap_of_asked),
+            ("min_turn_to_arap_allowed_deg", rules.min_turn_to_arap_allowed_deg),
         ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(config(format!("`{name}` must be a finite number >= 0, not {value}")));
@@ -50,12 +74,10 @@ impl VerdictRules {
         Ok(rules)
     }
 
-    /// The reasons a finished case with `quality` is suspect (empty: `ok`).
-    /// `largest_move` is the largest distance of any result vertex from its rest position and
-    /// `largest_handle_move` the largest distance of a handle target from its vertex's rest position
-    /// (over every edit step), both over the rest diagonal: a result is judged on itself, not against
-    /// another method's.
-    pub fn reasons(&self, quality: &Quality, largest_move: f64, largest_handle_move: f64) -> Vec<String> {
+    /// The reasons a finished case with `quality` and `motion` is suspect (empty: `ok`). A result is
+    /// judged on itself, and against the reference's result only where that finished.
+    pub fn reasons(&self, quality: &Quality, motion: Motion) -> Vec<String> {
+        let Motion { largest_move, largest_handle_move, asked_turn_deg, reference_finished } = motion;
         let mut reasons = Vec::new();
         let non_finite: Vec<&str> = quality.non_finite().map(Metric::key).collect();
         if !non_finite.is_empty() || !largest_move.is_finite() {
@@ -83,6 +105,15 @@ impl VerdictRules {
                 "turns a free region: a tenth of its free vertices turned {t:.0}° beyond what the handles ask \
                  (> {:.0}°)",
                 self.max_turn_beyond_handles_deg
+            ));
+        }
+        let allowed =
+            (self.max_turn_to_arap_of_asked * asked_turn_deg).max(self.min_turn_to_arap_allowed_deg);
+        if let Some(t) = quality.get(Metric::TurnToArap).filter(|t| reference_finished && *t > allowed) {
+            reasons.push(format!(
+                "turned against arap: half of its free surface turned {t:.0}° or more from arap's result \
+                 (> {allowed:.0}°, {:.1} of the {asked_turn_deg:.0}° the handles ask)",
+                self.max_turn_to_arap_of_asked
             ));
         }
         let allowed = largest_handle_move + self.frame_margin_diagonals;
@@ -277,7 +308,15 @@ mod tests {
             max_handle_residual_over_diag: 1e-3,
             frame_margin_diagonals: 1.0,
             max_turn_beyond_handles_deg: 45.0,
+            max_turn_to_arap_of_asked: 0.4,
+            min_turn_to_arap_allowed_deg: 5.0,
         }
+    }
+
+    /// A case that moved `largest_move` diagonals with handles moved 0.2, asked 50 deg, judged
+    /// against a finished reference.
+    fn moved(largest_move: f64) -> Motion {
+        Motion { largest_move, largest_handle_move: 0.2, asked_turn_deg: 50.0, reference_finished: true }
     }
 
     fn quality(folds: f64, residual: f64) -> Quality {
@@ -291,24 +330,39 @@ mod tests {
     #[test]
     fn each_reason_is_found_and_a_clean_case_is_ok() {
         let r = rules();
-        assert!(r.reasons(&quality(0.0, 1e-9), 0.3, 0.2).is_empty());
-        let folded = r.reasons(&quality(1e-4, 1e-9), 0.3, 0.2);
+        assert!(r.reasons(&quality(0.0, 1e-9), moved(0.3)).is_empty());
+        let folded = r.reasons(&quality(1e-4, 1e-9), moved(0.3));
         assert!(folded.len() == 1 && folded[0].starts_with("folds: 0.010%"), "{folded:?}");
-        let missed = r.reasons(&quality(0.0, 2e-3), 0.3, 0.2);
+        let missed = r.reasons(&quality(0.0, 2e-3), moved(0.3));
         assert!(missed.len() == 1 && missed[0].starts_with("misses its handles"), "{missed:?}");
         // 0.2 of handle motion + 1 diagonal of margin: 1.19 is inside, 1.21 outside.
-        assert!(r.reasons(&quality(0.0, 0.0), 1.19, 0.2).is_empty());
-        let left = r.reasons(&quality(0.0, 0.0), 1.21, 0.2);
+        assert!(r.reasons(&quality(0.0, 0.0), moved(1.19)).is_empty());
+        let left = r.reasons(&quality(0.0, 0.0), moved(1.21));
         assert!(left.len() == 1 && left[0].starts_with("leaves its frame"), "{left:?}");
         let mut turned = quality(0.0, 0.0);
         turned.set(Metric::TurnBeyondHandles, Some(44.0));
-        assert!(r.reasons(&turned, 0.3, 0.2).is_empty());
+        assert!(r.reasons(&turned, moved(0.3)).is_empty());
         turned.set(Metric::TurnBeyondHandles, Some(61.0));
-        let reasons = r.reasons(&turned, 0.3, 0.2);
+        let reasons = r.reasons(&turned, moved(0.3));
         assert!(reasons.len() == 1 && reasons[0].starts_with("turns a free region"), "{reasons:?}");
+        // Against the reference: 0.4 of the 50 deg asked, judged only where the reference finished,
+        // never below 5 deg.
+        let mut against = quality(0.0, 0.0);
+        against.set(Metric::TurnToArap, Some(19.0));
+        assert!(r.reasons(&against, moved(0.3)).is_empty());
+        against.set(Metric::TurnToArap, Some(21.0));
+        let reasons = r.reasons(&against, moved(0.3));
+        assert!(reasons.len() == 1 && reasons[0].starts_with("turned against arap: "), "{reasons:?}");
+        let unfinished = Motion { reference_finished: false, ..moved(0.3) };
+        assert!(r.reasons(&against, unfinished).is_empty(), "an unfinished reference judges nothing");
+        let still = Motion { asked_turn_deg: 0.0, ..moved(0.3) };
+        against.set(Metric::TurnToArap, Some(4.0));
+        assert!(r.reasons(&against, still).is_empty(), "the 5 deg floor");
+        against.set(Metric::TurnToArap, Some(6.0));
+        assert_eq!(r.reasons(&against, still).len(), 1);
         let mut q = quality(0.0, 0.0);
         q.set(Metric::EArea, Some(f64::INFINITY));
-        let nan = r.reasons(&q, f64::NAN, 0.2);
+        let nan = r.reasons(&q, moved(f64::NAN));
         assert_eq!(nan, vec!["non-finite e_area, positions".to_string()]);
     }
 
@@ -370,7 +424,7 @@ mod tests {
         std::fs::write(
             &path,
             "max_folds = -1\nmax_handle_residual_over_diag = 1e-3\nframe_margin_diagonals = 1\n\
-             max_turn_beyond_handles_deg = 45\n",
+             max_turn_beyond_handles_deg = 45\nmax_turn_to_arap_of_asked = 0.4\nmin_turn_to_arap_allowed_deg = 5\n",
         )
         .unwrap();
         let e = VerdictRules::load(&path).unwrap_err().to_string();
