@@ -1104,11 +1104,12 @@ fn unreferenced_vertices_are_dropped_and_results_keep_the_input_order() {
 }
 
 /// The real-mesh suite (`configs/real-meshes`): four meshes of `../shared/real-meshes` in OFF and
-/// OBJ, edited by scenarios written only in TOML (the knight and the head bust with libigl's own
-/// `.dmat` selections, the bunny and the 43K armadillo with shape selections), every method run on
-/// each.
+/// OBJ and an open terrain of its dataset, edited by scenarios written only in TOML (the knight and
+/// the head bust with libigl's own `.dmat` selections, the bunny, the 43K armadillo and the terrain
+/// with shape selections), every method run on each, and the run gated against its own committed
+/// baseline (`reports/baselines/real-meshes.json`, issue 35).
 #[test]
-fn the_real_mesh_suite_runs_from_toml_alone() {
+fn the_real_mesh_suite_runs_from_toml_alone_and_passes_its_gate() {
     let Some(_) = support::real_meshes_dir() else { return };
     let reports = tempfile::tempdir().unwrap();
     let scenarios = support::workspace_root().join("configs/real-meshes");
@@ -1122,20 +1123,74 @@ fn the_real_mesh_suite_runs_from_toml_alone() {
     ];
     assert_eq!(run(&args).unwrap(), std::process::ExitCode::SUCCESS);
     let rows = support::csv_rows(&reports.path().join("results.csv"));
-    assert_eq!(rows.len(), 4 * configured_methods(), "every method of configs/methods.toml on each test");
-    for (scenario, vertices) in [("knight", 502), ("max", 5272), ("bunny", 3485), ("armadillo", 43243)] {
+    let tests = [("knight", 502), ("max", 5272), ("bunny", 3485), ("armadillo", 43243), ("mountain", 25600)];
+    assert_eq!(
+        rows.len(),
+        tests.len() * configured_methods(),
+        "every method of configs/methods.toml on each test"
+    );
+    for (scenario, vertices) in tests {
         for row in rows.iter().filter(|r| r["scenario"] == scenario) {
             assert_eq!(row["mesh_source"], "file");
             assert_eq!(row["vertices"], vertices.to_string(), "{scenario}");
             assert!(!row["status"].starts_with("failed"), "{scenario}/{}: {}", row["method"], row["status"]);
         }
     }
+    // The run was gated: its page names the real-mesh baseline, and `check` reads the same one.
+    let page = std::fs::read_to_string(reports.path().join("index.html")).unwrap();
+    assert!(page.contains("real-meshes.json"), "the page names the baseline it was checked against");
+    let dir = reports.path().to_str().unwrap();
+    assert_eq!(run(&["check", "--reports", dir]).unwrap(), std::process::ExitCode::SUCCESS);
     // libigl's knight selection: region 0 held, 1 and 2 moved (three regions, 73 vertices).
     let updates = support::csv_rows(&reports.path().join("handle_updates.csv"));
     let knight = updates.iter().find(|u| u["scenario"] == "knight" && u["method"] == "arap").unwrap();
     assert_eq!((knight["handles"].as_str(), knight["constrained_vertices"].as_str()), ("3", "73"));
     let result = meshes::io::read_mesh(reports.path().join("meshes/max-isolines.glb")).unwrap();
     assert_eq!(result.n_vertices(), 5272, "written in the OBJ's vertex order");
+}
+
+/// Issue 35: the real-mesh gate catches a method's own regression on real data. `laplacian` with
+/// the one-ring frame of its Laplacian coordinates (commit 1744ef1's, which crumpled open scans) on
+/// the open terrain of the real-mesh suite fails the gate against the committed baseline.
+#[test]
+fn the_real_mesh_gate_catches_laplacian_with_the_one_ring_frame() {
+    let Some(_) = support::real_meshes_dir() else { return };
+    let root = support::workspace_root();
+    let terrain = std::fs::read_to_string(root.join("configs/real-meshes/mountain.toml")).unwrap();
+    let terrain = terrain.replacen("[[regions]]", "methods = [\"arap\", \"laplacian\"]\n\n[[regions]]", 1);
+    let configs = configs_with(&[("mountain.toml".to_string(), terrain)]);
+    let methods_toml = configs.path().join("methods.toml");
+    let text = std::fs::read_to_string(&methods_toml).unwrap();
+    let (head, tail) = text.split_at(text.find("[laplacian]").unwrap());
+    let broken =
+        format!("{head}{}", tail.replacen("delta_frame = \"normal_edge\"", "delta_frame = \"one_ring\"", 1));
+    assert_ne!(broken, text, "laplacian's frame was found");
+    std::fs::write(&methods_toml, broken).unwrap();
+    let reports = tempfile::tempdir().unwrap();
+    let baseline = root.join("reports/baselines/real-meshes.json");
+    let code = run(&[
+        "all",
+        "--quiet",
+        "--configs",
+        configs.path().to_str().unwrap(),
+        "--baseline",
+        baseline.to_str().unwrap(),
+        "--reports",
+        reports.path().to_str().unwrap(),
+    ])
+    .unwrap();
+    assert_eq!(code, std::process::ExitCode::from(harness::cli::EXIT_REGRESSION));
+    let rows = support::csv_rows(&reports.path().join("results.csv"));
+    let status = |method: &str| rows.iter().find(|r| r["method"] == method).unwrap()["status"].clone();
+    assert_eq!(status("arap"), "ok", "the reference is untouched");
+    assert!(
+        status("laplacian").starts_with("unfinished: stopped at the 2000-iteration cap"),
+        "{}",
+        status("laplacian")
+    );
+    let page = std::fs::read_to_string(reports.path().join("index.html")).unwrap();
+    assert!(page.contains("turned unfinished: mountain / laplacian"), "the gate names the case");
+    assert!(page.contains("worse: mountain / laplacian / e_phi_deg"), "and its E_phi");
 }
 
 /// A collection: one scenario `<name>-<stem>` per file the glob matches (sorted), the same shape

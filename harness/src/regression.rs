@@ -1,6 +1,6 @@
 //! The quality-regression gate: a committed baseline per data source (`reports/baselines/survey.json`
-//! for runs on the survey meshes, `reports/baselines/procedural.json` for the procedural look-alikes)
-//! holds the verdict and every gated measure of the metric table ([`crate::metrics::METRICS`]) of
+//! for runs on the survey meshes, `reports/baselines/procedural.json` for the procedural look-alikes,
+//! `reports/baselines/real-meshes.json` for the real-mesh suite, `configs/real-meshes`) holds the verdict and every gated measure of the metric table ([`crate::metrics::METRICS`]) of
 //! each (scenario, method). [`check`] compares a run against it and names every measure that got
 //! worse beyond its tolerance, every case whose status got worse (ok -> suspect or unfinished,
 //! suspect -> unfinished), failed or produced a non-finite measure, and every baseline case the run
@@ -46,13 +46,19 @@ pub enum BaselineKind {
     Survey,
     /// Procedural look-alikes only: a run without survey data.
     Procedural,
+    /// Mesh files only: the real-mesh suite (`configs/real-meshes`), the contract that catches a
+    /// method's regressions on real data (issue 35).
+    RealMeshes,
 }
 
 impl BaselineKind {
-    /// The kind for a run's `results`: `Survey` if any case ran on a survey mesh.
+    /// The kind for a run's `results`: `Survey` if any case ran on a survey mesh, `RealMeshes` if
+    /// every case ran on a mesh file, else `Procedural`.
     pub fn of(results: &[CaseResult]) -> BaselineKind {
         if results.iter().any(|r| r.mesh_source == "survey") {
             BaselineKind::Survey
+        } else if !results.is_empty() && results.iter().all(|r| r.mesh_source == "file") {
+            BaselineKind::RealMeshes
         } else {
             BaselineKind::Procedural
         }
@@ -63,6 +69,7 @@ impl BaselineKind {
         root.join("reports/baselines").join(match self {
             BaselineKind::Survey => "survey.json",
             BaselineKind::Procedural => "procedural.json",
+            BaselineKind::RealMeshes => "real-meshes.json",
         })
     }
 }
