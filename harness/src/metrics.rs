@@ -10,7 +10,7 @@ use std::fmt;
 use meshes::geometry::{corner_angles, dihedral_angles, edge_lengths, face_areas, signed_volume};
 use meshes::vector::{norm, sub};
 use meshes::{Topology, TriMesh};
-use methods::rotation_fit::{closest_rotation, cross_covariance, rotation_angle, Mat3, IDENTITY};
+use methods::rotation_fit::{closest_rotation, cross_covariance, rotation_angle};
 use methods::{HandleSet, HandleTargets};
 use serde::de::{IgnoredAny, MapAccess, Visitor};
 use serde::ser::SerializeMap;
@@ -680,21 +680,15 @@ pub fn asked_turn(rest: &[[f64; 3]], handles: &HandleSet, targets: &HandleTarget
 /// `sum_j (x_i - x_j)(x0_i - x0_j)^T` over its one-ring: how far its neighbourhood turned from
 /// `rest` to `result` (both `#V x 3`). An isolated vertex turns 0.
 pub fn one_ring_turns(rest: &[[f64; 3]], result: &[[f64; 3]], topology: &Topology) -> Vec<f64> {
-    one_ring_rotations(rest, result, topology).iter().map(rotation_angle).collect()
-}
-
-/// Per vertex, the rotation closest to `sum_j (x_i - x_j)(x0_i - x0_j)^T` over its one-ring, from
-/// `rest` to `result` (both `#V x 3`); the identity for an isolated vertex.
-pub fn one_ring_rotations(rest: &[[f64; 3]], result: &[[f64; 3]], topology: &Topology) -> Vec<Mat3> {
     (0..rest.len())
         .map(|i| {
             let ring = topology.one_ring(i);
             if ring.is_empty() {
-                return IDENTITY;
+                return 0.0;
             }
             let pairs =
                 ring.iter().map(|&j| (sub(rest[i], rest[j as usize]), sub(result[i], result[j as usize])));
-            closest_rotation(&cross_covariance(pairs))
+            turn_of(&cross_covariance(pairs))
         })
         .collect()
 }
@@ -892,6 +886,54 @@ mod tests {
         // The top 30%: a minority of the free surface, the median did not turn.
         let few = turn(&above(0.7), p);
         assert!(few < 5.0, "{few}");
+    }
+
+    /// Two handles pulled apart across a small gap ask a sharp bend between them; counted from the
+    /// held region only, the asked turn is the gentle one from the base to the handles.
+    #[test]
+    fn bends_from_held_regions_leave_out_two_handles_pulled_apart() {
+        let (mesh, _, _) = shape(ShapeKind::Bar);
+        let p = mesh.positions();
+        let (lo, hi) = mesh.bbox();
+        let (mid_x, top) = (0.5 * (lo[0] + hi[0]), lo[2] + 0.9 * (hi[2] - lo[2]));
+        let region = |name: &str, keep: &dyn Fn([f64; 3]) -> bool| methods::HandleRegion {
+            name: name.into(),
+            vertices: (0..p.len() as u32).filter(|&v| keep(p[v as usize])).collect(),
+        };
+        let handles = HandleSet::new(
+            vec![
+                region("base", &|x| x[2] < lo[2] + 0.05 * (hi[2] - lo[2])),
+                region("left", &|x| x[2] > top && x[0] < mid_x - 0.1),
+                region("right", &|x| x[2] > top && x[0] > mid_x + 0.1),
+            ],
+            p.len(),
+        )
+        .unwrap();
+        let apart = 0.5 * (hi[0] - lo[0]);
+        let region_of = handles.region_of();
+        let targets = HandleTargets::new(
+            &handles,
+            handles
+                .constrained()
+                .map(|v| {
+                    let x = p[v as usize];
+                    let r = region_of[v as usize];
+                    let dx = if r == 1 {
+                        -apart
+                    } else if r == 2 {
+                        apart
+                    } else {
+                        0.0
+                    };
+                    [x[0] + dx, x[1], x[2]]
+                })
+                .collect(),
+        )
+        .unwrap();
+        let all = asked_turn(p, &handles, &targets, Bends::All).to_degrees();
+        let from_held = asked_turn(p, &handles, &targets, Bends::FromHeld).to_degrees();
+        assert!(all > 90.0, "pulled apart across a gap of 0.2: {all}");
+        assert!(from_held > 0.0 && from_held < 20.0, "from the base far below: {from_held}");
     }
 
     #[test]
