@@ -691,6 +691,17 @@ fn read_json(path: &Path) -> serde_json::Value {
         .unwrap()
 }
 
+/// Replace the first `from` at or after `[laplacian]` in `configs`' methods.toml by `to` (a test
+/// that breaks the method on purpose); fails when there is no such line.
+fn edit_laplacian_section(configs: &Path, from: &str, to: &str) {
+    let methods_toml = configs.join("methods.toml");
+    let text = std::fs::read_to_string(&methods_toml).unwrap();
+    let (head, tail) = text.split_at(text.find("[laplacian]").unwrap());
+    let edited = format!("{head}{}", tail.replacen(from, to, 1));
+    assert_ne!(edited, text, "`{from}` in [laplacian]");
+    std::fs::write(&methods_toml, edited).unwrap();
+}
+
 /// A configs directory (the committed methods.toml and verdicts.toml) with `scenarios` as
 /// `(file name, contents)`.
 fn configs_with(scenarios: &[(String, String)]) -> tempfile::TempDir {
@@ -1159,13 +1170,7 @@ fn the_real_mesh_gate_catches_laplacian_with_the_one_ring_frame() {
     let terrain = std::fs::read_to_string(root.join("configs/real-meshes/mountain.toml")).unwrap();
     let terrain = terrain.replacen("[[regions]]", "methods = [\"arap\", \"laplacian\"]\n\n[[regions]]", 1);
     let configs = configs_with(&[("mountain.toml".to_string(), terrain)]);
-    let methods_toml = configs.path().join("methods.toml");
-    let text = std::fs::read_to_string(&methods_toml).unwrap();
-    let (head, tail) = text.split_at(text.find("[laplacian]").unwrap());
-    let broken =
-        format!("{head}{}", tail.replacen("delta_frame = \"normal_edge\"", "delta_frame = \"one_ring\"", 1));
-    assert_ne!(broken, text, "laplacian's frame was found");
-    std::fs::write(&methods_toml, broken).unwrap();
+    edit_laplacian_section(configs.path(), "delta_frame = \"normal_edge\"", "delta_frame = \"one_ring\"");
     let reports = tempfile::tempdir().unwrap();
     let baseline = root.join("reports/baselines/real-meshes.json");
     let code = run(&[
@@ -1316,12 +1321,7 @@ fn a_case_stopped_at_its_cap_is_unfinished_and_the_gate_sees_it() {
     assert_eq!(all(&dir("same")), std::process::ExitCode::SUCCESS, "the same run passes its own baseline");
 
     // laplacian capped at 2 iterations: it cannot reach its tolerance.
-    let methods_toml = configs.path().join("methods.toml");
-    let text = std::fs::read_to_string(&methods_toml).unwrap();
-    let (head, tail) = text.split_at(text.find("[laplacian]").unwrap());
-    let capped = format!("{head}{}", tail.replacen("max_iterations = 2000", "max_iterations = 2", 1));
-    assert_ne!(capped, text, "the laplacian cap was found");
-    std::fs::write(&methods_toml, capped).unwrap();
+    edit_laplacian_section(configs.path(), "max_iterations = 2000", "max_iterations = 2");
     let second = dir("second");
     assert_eq!(all(&second), std::process::ExitCode::from(harness::cli::EXIT_REGRESSION));
     let rows = support::csv_rows(&work.path().join("second/results.csv"));
