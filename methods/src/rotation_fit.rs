@@ -99,7 +99,7 @@ pub const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 /// Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations: `(eigenvalues, V)` with
 /// the eigenvectors in the columns of `V`.
-fn symmetric_eigen3(mut a: Mat3) -> ([f64; 3], Mat3) {
+pub fn symmetric_eigen3(mut a: Mat3) -> ([f64; 3], Mat3) {
     let mut v = IDENTITY;
     let scale2 = (0..3).map(|i| a[i][i] * a[i][i]).sum::<f64>() + 1e-300;
     for _sweep in 0..32 {

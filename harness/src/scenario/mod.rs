@@ -45,6 +45,7 @@
 //! translate = [0.0, 0.0, 0.05]   # target = current position + translate x diagonal
 //! ```
 
+pub mod frame;
 pub mod motion;
 pub mod selection;
 
@@ -56,6 +57,7 @@ use methods::{HandleRegion, HandleSet, HandleTargets};
 use serde::Deserialize;
 
 use crate::error::HarnessError;
+pub use frame::{Frame, PrincipalFrame};
 pub use motion::{Motion, RotateSpec, TransformSpec, Units};
 pub use selection::{FilesRead, InputIndex, PathContext, Role, Selection, SelectionFiles};
 
@@ -86,6 +88,10 @@ pub struct ScenarioSpec {
     /// The axis the mesh stands on, drawn upwards in the figures (default `z`, the survey's).
     #[serde(default)]
     pub up: Option<selection::Axis>,
+    /// The frame `[[regions]]` and patches are written in: `"bbox"` (default) or `"principal"`, the
+    /// rest mesh's principal axes ([`frame`]).
+    #[serde(default)]
+    pub frame: Frame,
     /// The regions of the first edit (default for `survey`/`procedural`: the survey selection).
     #[serde(default)]
     pub regions: Vec<RegionSpec>,
@@ -447,18 +453,26 @@ impl ScenarioSpec {
             )),
             (_, None, None) => return Err(fail("has neither `survey` nor `procedural`".into())),
         };
-        let initial = if self.regions.is_empty() {
+        let steps = if self.regions.is_empty() {
+            if self.frame != Frame::Bbox {
+                return Err(fail(
+                    "`frame` applies to [[regions]]; the survey edit is in the mesh's own coordinates".into(),
+                ));
+            }
             let (regions, motions) =
                 survey_regions(&selection, &transform).map_err(|e| fail(e.to_string()))?;
             let roles =
                 regions.iter().map(|r| if r.name == "fixed" { Role::Fixed } else { Role::Handle }).collect();
-            InitialEdit { regions, motions, roles }
+            self.resolve_steps(&mesh, &InitialEdit { regions, motions, roles }).map_err(fail)?
         } else {
             let input = InputIndex::identity(mesh.n_vertices());
             let files = InputFiles { n_input: mesh.n_vertices() };
-            self.regions_edit(&mesh, &input, &self.paths(None), &files).map_err(fail)?
+            self.steps_in_frame(&mesh, |m| {
+                let initial = self.regions_edit(m, &input, &self.paths(None), &files)?;
+                self.resolve_steps(m, &initial)
+            })
+            .map_err(fail)?
         };
-        let steps = self.resolve_steps(&mesh, &initial).map_err(fail)?;
         check_components(&mesh, &steps, None).map_err(fail)?;
         Ok(LoadedScenario {
             spec: self.clone(),
@@ -507,14 +521,39 @@ impl ScenarioSpec {
         }
         let index = InputIndex { kept_of_input };
         let files = InputFiles { n_input: input.n_vertices() };
-        let initial = self.regions_edit(&mesh, &index, &self.paths(stem), &files).map_err(fail)?;
         let mut spec = self.clone();
         spec.name = name.to_string();
-        let steps = spec.resolve_steps(&mesh, &initial).map_err(fail)?;
+        let paths = self.paths(stem);
+        let steps = spec
+            .steps_in_frame(&mesh, |m| {
+                let initial = spec.regions_edit(m, &index, &paths, &files)?;
+                spec.resolve_steps(m, &initial)
+            })
+            .map_err(fail)?;
         let kept = map.kept().to_vec();
         check_components(&mesh, &steps, Some(&kept)).map_err(|e| fail(format!("{}: {e}", path.display())))?;
         let input = (!dropped.is_empty()).then(|| InputMesh { mesh: input, kept });
         Ok(LoadedScenario { spec, mesh_source: FILE_SOURCE.to_string(), mesh, topology, steps, input, notes })
+    }
+
+    /// The steps `build` makes from `mesh` posed in the scenario's [`Frame`], their motions taken
+    /// back to where `mesh` lies (vertex indices are the same in both).
+    fn steps_in_frame(
+        &self,
+        mesh: &TriMesh,
+        build: impl FnOnce(&TriMesh) -> Result<Vec<LoadedStep>, String>,
+    ) -> Result<Vec<LoadedStep>, String> {
+        match self.frame {
+            Frame::Bbox => build(mesh),
+            Frame::Principal => {
+                let frame = PrincipalFrame::of(mesh);
+                let mut steps = build(&frame.pose(mesh))?;
+                for step in &mut steps {
+                    step.motions = step.motions.iter().map(|m| frame.to_world(m)).collect();
+                }
+                Ok(steps)
+            }
+        }
     }
 
     /// The `[[regions]]` on `mesh`: vertices selected (file-based selections through `input`), free
