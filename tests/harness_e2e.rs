@@ -1406,3 +1406,87 @@ fn sweeps_add_points_named_by_their_values_and_a_budget_table_that_picks_the_bes
         best["method"]
     );
 }
+
+/// Issue 36: a collection from a manifest, its rows filtered by their columns, an edit taken from
+/// another file (`extends`); a mesh that cannot run (a zero-area face; a component no region
+/// reaches) is skipped with its reason, listed in results.json and on the page, and the others run.
+/// A collection whose every mesh is skipped is an error that names the first reason.
+#[test]
+fn a_manifest_collection_skips_the_meshes_that_cannot_run_and_runs_the_others() {
+    let data = tempfile::tempdir().unwrap();
+    let bar = generate(ShapeKind::Bar, 500).unwrap().mesh;
+    meshes::io::write_off(data.path().join("good.off"), &bar).unwrap();
+    meshes::io::write_off(data.path().join("big.off"), &generate(ShapeKind::Bar, 2000).unwrap().mesh)
+        .unwrap();
+    let mut flat = bar.positions().to_vec();
+    let t0 = bar.triangles()[0];
+    flat[t0[2] as usize] = flat[t0[0] as usize];
+    std::fs::write(data.path().join("flat.off"), {
+        let mut off = format!("OFF\n{} {} 0\n", flat.len(), bar.n_faces());
+        flat.iter().for_each(|p| off += &format!("{} {} {}\n", p[0], p[1], p[2]));
+        bar.triangles().iter().for_each(|t| off += &format!("3 {} {} {}\n", t[0], t[1], t[2]));
+        off
+    })
+    .unwrap();
+    // The bar and a small copy of it beside its middle, which neither end region reaches.
+    let n = bar.n_vertices() as u32;
+    let (lo, hi) = bar.bbox();
+    let middle: [f64; 3] = std::array::from_fn(|c| 0.5 * (lo[c] + hi[c]));
+    let mut p = bar.positions().to_vec();
+    p.extend(bar.positions().iter().map(|q| {
+        std::array::from_fn(|c| {
+            middle[c] + 0.05 * (q[c] - middle[c]) + if c == 0 { 2.0 * (hi[0] - lo[0]) } else { 0.0 }
+        })
+    }));
+    let mut t = bar.triangles().to_vec();
+    t.extend(bar.triangles().iter().map(|f| f.map(|v| v + n)));
+    meshes::io::write_off(data.path().join("two.off"), &meshes::TriMesh::new(p, t).unwrap()).unwrap();
+    let manifest =
+        "file,vertices,category\ngood.off,500,bar\nflat.off,500,bar\ntwo.off,1000,pair\nbig.off,2000,bar\n";
+    std::fs::write(data.path().join("MANIFEST.csv"), manifest).unwrap();
+
+    let edit = "name = \"bend\"\nmethods = [\"arap\", \"laplacian\"]\nframe = \"principal\"\n\
+                [[regions]]\nname = \"held\"\nrole = \"fixed\"\nselect = { box = { min = [0.0, 0.0, 0.0], max = [0.1, 1.0, 1.0] } }\n\
+                [[regions]]\nname = \"moved\"\nrole = \"handle\"\nselect = { box = { min = [0.9, 0.0, 0.0], max = [1.0, 1.0, 1.0] } }\n\
+                rotate = { axis = [0, 1, 0], degrees = 30, about = \"centroid\" }\n";
+    let family = tempfile::tempdir().unwrap();
+    std::fs::write(family.path().join("bend.toml"), edit).unwrap();
+    let tier = |conditions: &str| {
+        format!(
+            "extends = \"{}\"\n[manifest]\nfile = \"{}\"\nwhere = [{conditions}]\n",
+            family.path().join("bend.toml").display(),
+            data.path().join("MANIFEST.csv").display()
+        )
+    };
+    let configs = configs_with(&[("bend.toml".to_string(), tier("\"vertices <= 1000\""))]);
+    let reports = tempfile::tempdir().unwrap();
+    let code = all_with(configs.path(), reports.path()).unwrap();
+    assert_eq!(code, std::process::ExitCode::SUCCESS);
+    let rows = support::csv_rows(&reports.path().join("results.csv"));
+    let cases: Vec<(&str, &str)> =
+        rows.iter().map(|r| (r["scenario"].as_str(), r["method"].as_str())).collect();
+    assert_eq!(cases, [("bend-good", "laplacian"), ("bend-good", "arap")], "big.off is filtered out");
+    let json = read_json(&reports.path().join("results.json"));
+    let skipped = json["skipped"].as_array().expect("results.json lists the skipped meshes");
+    let reasons: Vec<(&str, &str)> =
+        skipped.iter().map(|s| (s["scenario"].as_str().unwrap(), s["reason"].as_str().unwrap())).collect();
+    assert_eq!(reasons.len(), 2, "{reasons:?}");
+    assert_eq!(reasons[0].0, "bend-flat");
+    assert!(reasons[0].1.contains("flat.off") && reasons[0].1.contains("zero area"), "{reasons:?}");
+    assert_eq!(reasons[1].0, "bend-two");
+    assert!(reasons[1].1.contains("connected component 1 of 2"), "{reasons:?}");
+    assert_eq!(json["cases"][0]["member"]["collection"], "bend");
+    assert_eq!(json["cases"][0]["member"]["mesh"], "good");
+    let page = std::fs::read_to_string(reports.path().join("index.html")).unwrap();
+    assert!(page.contains("skipped `bend-flat`") && page.contains("skipped `bend-two`"));
+
+    let configs = configs_with(&[("bend.toml".to_string(), tier("\"category = \\\"pair\\\"\""))]);
+    let message = format!("{:#}", all_with(configs.path(), reports.path()).unwrap_err());
+    assert!(
+        message.contains("every one of its 1 meshes was skipped") && message.contains("two.off"),
+        "{message}"
+    );
+    let configs = configs_with(&[("bend.toml".to_string(), tier("\"genus >= 1\""))]);
+    let message = format!("{:#}", all_with(configs.path(), reports.path()).unwrap_err());
+    assert!(message.contains("no column `genus`"), "{message}");
+}

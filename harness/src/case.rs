@@ -89,6 +89,10 @@ pub struct CaseResult {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub about: Option<String>,
     pub mesh_source: String,
+    /// The collection (edit family) and mesh this case's scenario is one of, with the mesh's
+    /// manifest row ([`crate::scenario::Member`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub member: Option<crate::scenario::Member>,
     pub vertices: usize,
     pub faces: usize,
     /// The Laplacian weights the method ran with (`weights` in configs/methods.toml).
@@ -421,6 +425,7 @@ pub fn run_case(
         scenario.mesh.n_faces(),
     );
     result.origin = method.origin;
+    result.member = scenario.member.clone();
     result.sweeps = method.sweeps.clone();
     result.laplacian_weights = match method.origin {
         Origin::BuiltIn => laplacian_weights(params),
@@ -623,6 +628,7 @@ impl CaseResult {
             origin: Origin::BuiltIn,
             about: None,
             mesh_source: mesh_source.to_string(),
+            member: None,
             vertices,
             faces,
             laplacian_weights: String::new(),

@@ -170,6 +170,7 @@ pub fn publish(
         &run.scenarios,
         &run.data_source,
         &run.provenance,
+        &run.skipped,
         &peers,
         &publish.meshes,
     )?;
@@ -230,6 +231,7 @@ pub fn publish_partial(options: &SuiteOptions, run: &SuiteRun, shard: Shard) -> 
         &run.scenarios,
         &run.data_source,
         &run.provenance,
+        &run.skipped,
         shard,
     )?;
     Ok(run.results.iter().filter(|r| r.status.is_failed()).count())

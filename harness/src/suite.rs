@@ -12,7 +12,9 @@ use crate::config::{MethodCatalog, PeerSetup};
 use crate::error::HarnessError;
 use crate::metrics::RestGeometry;
 use crate::provenance::Provenance;
-use crate::scenario::{load_spec, load_specs, DataSource, LoadedScenario, ScenarioSpec, FILE_SOURCE};
+use crate::scenario::{
+    load_spec, load_specs, DataSource, LoadedScenario, ScenarioSpec, SkippedInput, FILE_SOURCE,
+};
 use crate::shard::{assign, estimated_cost, Shard};
 use crate::verdict::VerdictRules;
 
@@ -62,6 +64,8 @@ pub struct SuiteOptions {
 pub struct SuiteRun {
     pub results: Vec<CaseResult>,
     pub scenarios: Vec<LoadedScenario>,
+    /// The meshes of collections that no case ran on, with the reason.
+    pub skipped: Vec<SkippedInput>,
     pub data_source: String,
     /// What loading the scenarios noticed (dropped or duplicate vertices), each naming its scenario.
     pub notes: Vec<String>,
@@ -104,9 +108,18 @@ pub struct RunConfig {
     pub rules: VerdictRules,
 }
 
+/// A run ready to start: its configuration, the scenarios that loaded, the meshes of collections
+/// skipped, and where the survey meshes come from.
+pub struct Prepared {
+    pub config: RunConfig,
+    pub scenarios: Vec<LoadedScenario>,
+    pub skipped: Vec<SkippedInput>,
+    pub source: DataSource,
+}
+
 /// Load and validate the configuration (`methods.toml`, the peers when asked for, `verdicts.toml`)
 /// and every selected scenario.
-pub fn prepare(options: &SuiteOptions) -> Result<(RunConfig, Vec<LoadedScenario>, DataSource), HarnessError> {
+pub fn prepare(options: &SuiteOptions) -> Result<Prepared, HarnessError> {
     let catalog = load_catalog(options)?;
     let rules = VerdictRules::load(&options.configs_dir.join("verdicts.toml"))?;
     for m in &options.methods {
@@ -125,10 +138,13 @@ pub fn prepare(options: &SuiteOptions) -> Result<(RunConfig, Vec<LoadedScenario>
     }
     let source = options.data_source()?;
     let mut scenarios = Vec::with_capacity(specs.len());
+    let mut skipped = Vec::new();
     for spec in &specs {
-        scenarios.extend(spec.load(&source)?);
+        let loaded = spec.load(&source)?;
+        scenarios.extend(loaded.scenarios);
+        skipped.extend(loaded.skipped);
     }
-    Ok((RunConfig { catalog, rules }, scenarios, source))
+    Ok(Prepared { config: RunConfig { catalog, rules }, scenarios, skipped, source })
 }
 
 /// The methods of a run: `methods.toml` of the configuration directory, and the peers if asked for.
@@ -203,19 +219,26 @@ fn plan(options: &SuiteOptions, catalog: &MethodCatalog, scenarios: &[LoadedScen
 /// the others can be compared with it; results are reported in registry order.
 pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
     let mut provenance = record_of(options);
-    let (config, scenarios, source) = prepare(options)?;
+    let Prepared { config, scenarios, skipped, source } = prepare(options)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let plan = plan(options, &config.catalog, &scenarios);
     let results = run_plan(options, &config, &scenarios, &plan)?;
     provenance.external = crate::provenance::external_records(&results);
     let data_source = describe_data(&source, &scenarios);
-    Ok(SuiteRun { notes: notes_of(options, &scenarios), results, scenarios, data_source, provenance })
+    Ok(SuiteRun {
+        notes: notes_of(options, &scenarios, &skipped),
+        results,
+        scenarios,
+        skipped,
+        data_source,
+        provenance,
+    })
 }
 
 /// Run the scenarios of part `shard` of the suite ([`crate::shard::assign`] on their estimated cost).
 pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, HarnessError> {
     let mut provenance = record_of(options);
-    let (config, scenarios, source) = prepare(options)?;
+    let Prepared { config, scenarios, skipped, source } = prepare(options)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let data_source = describe_data(&source, &scenarios);
     let plan = plan(options, &config.catalog, &scenarios);
@@ -235,7 +258,14 @@ pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, Harne
     let scenarios: Vec<LoadedScenario> = mine.into_iter().map(|(s, _)| s).collect();
     let results = run_plan(options, &config, &scenarios, &plan)?;
     provenance.external = crate::provenance::external_records(&results);
-    Ok(SuiteRun { notes: notes_of(options, &scenarios), results, scenarios, data_source, provenance })
+    Ok(SuiteRun {
+        notes: notes_of(options, &scenarios, &skipped),
+        results,
+        scenarios,
+        skipped,
+        data_source,
+        provenance,
+    })
 }
 
 /// The record of a run started now with `options`.
@@ -255,12 +285,18 @@ fn inputs_of(options: &SuiteOptions, scenarios: &[LoadedScenario]) -> Vec<PathBu
     paths
 }
 
-/// The notes of every scenario, each named, and what concurrent cases do to the timings.
-fn notes_of(options: &SuiteOptions, scenarios: &[LoadedScenario]) -> Vec<String> {
+/// The notes of every scenario, each named, every mesh of a collection skipped with its reason,
+/// and what concurrent cases do to the timings.
+fn notes_of(options: &SuiteOptions, scenarios: &[LoadedScenario], skipped: &[SkippedInput]) -> Vec<String> {
     let mut notes: Vec<String> = scenarios
         .iter()
         .flat_map(|s| s.notes.iter().map(move |n| format!("scenario `{}`: {n}", s.spec.name)))
         .collect();
+    notes.extend(
+        skipped
+            .iter()
+            .map(|s| format!("skipped `{}`: no case ran on {}: {}", s.scenario, s.file.display(), s.reason)),
+    );
     if options.jobs > 1 {
         notes.push(format!(
             "cases ran {} at a time (--jobs), each on {} thread(s): they share the memory bandwidth and caches, \
@@ -443,15 +479,16 @@ impl SharedCases<'_> {
 /// N), a case of a scenario the options do not load, a mesh that does not fit its scenario.
 pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, HarnessError> {
     let mut provenance = record_of(options);
-    let (config, scenarios, source) = prepare(options)?;
+    let Prepared { config, scenarios, skipped, source } = prepare(options)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let data_source = describe_data(&source, &scenarios);
     let mut records: Vec<(usize, Provenance)> = Vec::new();
     let mut parts: Vec<(Shard, PathBuf, Vec<CaseResult>)> = Vec::with_capacity(dirs.len());
     for dir in dirs {
         let path = dir.join("results.json");
-        let crate::report::StoredReport { cases, data_source: their_source, shard, provenance: record } =
-            crate::report::read_results(&path)?;
+        let crate::report::StoredReport {
+            cases, data_source: their_source, shard, provenance: record, ..
+        } = crate::report::read_results(&path)?;
         let config = |message: String| HarnessError::Config { path: path.clone(), message };
         let shard = shard.ok_or_else(|| config("not a partial report (written without --shard)".into()))?;
         if their_source != data_source {
@@ -509,7 +546,14 @@ pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, Harne
     }
     results.sort_by_key(|(i, order, _)| (*i, *order));
     let results: Vec<CaseResult> = results.into_iter().map(|(_, _, c)| c).collect();
-    Ok(SuiteRun { notes: notes_of(options, &scenarios), results, scenarios, data_source, provenance })
+    Ok(SuiteRun {
+        notes: notes_of(options, &scenarios, &skipped),
+        results,
+        scenarios,
+        skipped,
+        data_source,
+        provenance,
+    })
 }
 
 /// One line on where the meshes of `scenarios` came from.

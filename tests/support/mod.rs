@@ -43,6 +43,16 @@ pub fn real_meshes_dir() -> Option<PathBuf> {
     }
 }
 
+/// The real-mesh dataset named by `$DEFORM_DATASET_DIR` (79 meshes and their MANIFEST.csv; the
+/// scenarios of `configs/dataset*` read it from there; `scripts/test` sets it to
+/// `../shared/real-meshes/dataset`).
+pub fn dataset_dir() -> Option<PathBuf> {
+    match std::env::var_os("DEFORM_DATASET_DIR").map(PathBuf::from) {
+        Some(dir) if dir.join("MANIFEST.csv").is_file() => Some(dir),
+        _ => unavailable("the real-mesh dataset (DEFORM_DATASET_DIR)"),
+    }
+}
+
 /// The cross-check interpreter: `$DEFORMBENCH_PYTHON` (set up by scripts/python-env).
 pub fn python() -> Option<PathBuf> {
     match std::env::var_os("DEFORMBENCH_PYTHON") {

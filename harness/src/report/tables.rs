@@ -11,7 +11,7 @@ use crate::case::CaseResult;
 use crate::error::HarnessError;
 use crate::metrics::METRICS;
 use crate::provenance::Provenance;
-use crate::scenario::LoadedScenario;
+use crate::scenario::{LoadedScenario, SkippedInput};
 use crate::shard::Shard;
 
 /// The CSV columns before the metrics, with units in the names.
@@ -71,6 +71,9 @@ struct JsonReport<'a> {
     units: &'static str,
     provenance: &'a Provenance,
     cases: &'a [CaseResult],
+    /// Meshes of collections no case ran on, with the reason.
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    skipped: &'a [SkippedInput],
 }
 
 /// A `results.json` read back.
@@ -81,6 +84,8 @@ pub struct StoredReport {
     pub shard: Option<Shard>,
     /// Where and how it was made (none in a report of an older harness).
     pub provenance: Option<Provenance>,
+    /// Meshes of collections no case ran on.
+    pub skipped: Vec<SkippedInput>,
 }
 
 /// Read a `results.json` written by a run (or a shard of one).
@@ -93,6 +98,8 @@ pub fn read_results(path: &Path) -> Result<StoredReport, HarnessError> {
         #[serde(default)]
         provenance: Option<Provenance>,
         cases: Vec<CaseResult>,
+        #[serde(default)]
+        skipped: Vec<SkippedInput>,
     }
     let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
     let text = std::fs::read(path).map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
@@ -105,6 +112,7 @@ pub fn read_results(path: &Path) -> Result<StoredReport, HarnessError> {
         data_source: stored.data_source,
         shard,
         provenance: stored.provenance,
+        skipped: stored.skipped,
     })
 }
 
@@ -172,6 +180,7 @@ pub fn render_json(
     results: &[CaseResult],
     data_source: &str,
     provenance: &Provenance,
+    skipped: &[SkippedInput],
     shard: Option<Shard>,
 ) -> Result<Vec<u8>, HarnessError> {
     let report = JsonReport {
@@ -181,6 +190,7 @@ pub fn render_json(
         units: "times in seconds (median_iteration_ms in milliseconds); angles in degrees; *_over_diag relative to the rest bounding-box diagonal; e_area, e_length RMS log ratios; volume_change and folds fractions",
         provenance,
         cases: results,
+        skipped,
     };
     // NaN is not JSON: serde_json writes it as null, which is what a missing value should be.
     serde_json::to_vec_pretty(&report).map_err(|e| HarnessError::Report(format!("JSON: {e}")))
@@ -356,11 +366,12 @@ pub fn write_reports(
     scenarios: &[LoadedScenario],
     data_source: &str,
     provenance: &Provenance,
+    skipped: &[SkippedInput],
     peers: &str,
     meshes: &MeshOutput,
 ) -> Result<(), HarnessError> {
     let csv = render_csv(results)?;
-    let json = render_json(results, data_source, provenance, None)?;
+    let json = render_json(results, data_source, provenance, skipped, None)?;
     write_meshes(dir, results, scenarios, meshes)?;
     write_bytes(&dir.join("convergence.csv"), &render_convergence(results)?)?;
     write_bytes(&dir.join("handle_updates.csv"), &render_handle_updates(results)?)?;
@@ -381,9 +392,10 @@ pub fn write_partial(
     scenarios: &[LoadedScenario],
     data_source: &str,
     provenance: &Provenance,
+    skipped: &[SkippedInput],
     shard: Shard,
 ) -> Result<(), HarnessError> {
-    let json = render_json(results, data_source, provenance, Some(shard))?;
+    let json = render_json(results, data_source, provenance, skipped, Some(shard))?;
     let every_mesh = MeshOutput { format: MeshFormat::Off, every_scenario: true };
     write_meshes(dir, results, scenarios, &every_mesh)?;
     write_bytes(&dir.join("results.json"), &json)

@@ -46,6 +46,7 @@
 //! ```
 
 pub mod frame;
+pub mod manifest;
 pub mod motion;
 pub mod selection;
 
@@ -54,10 +55,11 @@ use std::path::{Path, PathBuf};
 use meshes::shapes::{self, ShapeKind};
 use meshes::{AffineTransform, Topology, TriMesh, VertexStatus};
 use methods::{HandleRegion, HandleSet, HandleTargets};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::HarnessError;
 pub use frame::{Frame, PrincipalFrame};
+pub use manifest::{ManifestEntry, ManifestSpec};
 pub use motion::{Motion, RotateSpec, TransformSpec, Units};
 pub use selection::{FilesRead, InputIndex, PathContext, Role, Selection, SelectionFiles};
 
@@ -85,6 +87,10 @@ pub struct ScenarioSpec {
     /// A glob of mesh files: one scenario `<name>-<stem>` per match, in sorted order.
     #[serde(default)]
     pub meshes: Option<String>,
+    /// The rows of a manifest CSV that meet its conditions: one scenario `<name>-<stem>` per row
+    /// ([`manifest`]).
+    #[serde(default)]
+    pub manifest: Option<ManifestSpec>,
     /// The axis the mesh stands on, drawn upwards in the figures (default `z`, the survey's).
     #[serde(default)]
     pub up: Option<selection::Axis>,
@@ -245,6 +251,49 @@ pub struct LoadedScenario {
     pub input: Option<InputMesh>,
     /// What loading noticed (dropped or duplicate vertices), for the run's output and the page.
     pub notes: Vec<String>,
+    /// The collection and mesh this scenario is one of (`meshes` or `[manifest]`).
+    pub member: Option<Member>,
+}
+
+/// What [`ScenarioSpec::load`] made of a scenario file: the scenarios that load, and the meshes
+/// of a collection it skipped.
+pub struct Loaded {
+    pub scenarios: Vec<LoadedScenario>,
+    pub skipped: Vec<SkippedInput>,
+}
+
+/// A scenario of a collection: the collection's name (its scenario file's `name`, the edit family
+/// of a dataset), the mesh file's stem, and the mesh's row of the manifest (empty for a glob).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Member {
+    pub collection: String,
+    pub mesh: String,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub attributes: Vec<(String, String)>,
+}
+
+impl Member {
+    /// The manifest's value of `column`, if it has one.
+    pub fn attribute(&self, column: &str) -> Option<&str> {
+        self.attributes.iter().find(|(c, _)| c == column).map(|(_, v)| v.as_str())
+    }
+}
+
+/// A mesh of a collection that no case ran on: the scenario it would have been, its file, and why.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SkippedInput {
+    pub scenario: String,
+    pub file: PathBuf,
+    pub reason: String,
+    pub member: Member,
+}
+
+/// The reason a collection's mesh is skipped, without the scenario name the record already has.
+fn skip_reason(error: &HarnessError) -> String {
+    match error {
+        HarnessError::Scenario { message, .. } => message.clone(),
+        other => other.to_string(),
+    }
 }
 
 /// A mesh file as read, and which of its vertices the scenario's mesh kept.
@@ -317,22 +366,29 @@ pub fn load_specs(dir: &Path) -> Result<Vec<ScenarioSpec>, HarnessError> {
 /// Read and check one scenario file.
 pub fn load_spec(path: &Path) -> Result<ScenarioSpec, HarnessError> {
     let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
-    let text = std::fs::read_to_string(path)
-        .map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
-    let mut spec: ScenarioSpec = toml::from_str(&text).map_err(|e| config(e.to_string()))?;
+    let table = read_extended(path, 0)?;
+    let mut spec: ScenarioSpec = table.try_into().map_err(|e: toml::de::Error| config(e.to_string()))?;
     spec.path = path.to_path_buf();
     let builtin = spec.survey.is_some() || spec.procedural.is_some();
-    let files = spec.mesh.is_some() as usize + spec.meshes.is_some() as usize;
+    let files =
+        spec.mesh.is_some() as usize + spec.meshes.is_some() as usize + spec.manifest.is_some() as usize;
     match (builtin, files) {
         (false, 0) => {
-            return Err(config("a scenario needs a mesh: `mesh`, `meshes`, `survey` or `procedural`".into()))
+            return Err(config(
+                "a scenario needs a mesh: `mesh`, `meshes`, `[manifest]`, `survey` or `procedural`".into(),
+            ))
         }
         (true, 1..) => {
             return Err(config(
-                "give either a mesh file (`mesh`, `meshes`) or `survey`/`procedural`, not both".into(),
+                "give either a mesh file (`mesh`, `meshes`, `[manifest]`) or `survey`/`procedural`, not both"
+                    .into(),
             ))
         }
-        (_, 2) => return Err(config("give one of `mesh` (a file) and `meshes` (a glob), not both".into())),
+        (_, 2..) => {
+            return Err(config(
+                "give one of `mesh` (a file), `meshes` (a glob) and `[manifest]` (a filtered CSV)".into(),
+            ))
+        }
         _ => {}
     }
     if files > 0 && spec.regions.is_empty() {
@@ -344,6 +400,40 @@ pub fn load_spec(path: &Path) -> Result<ScenarioSpec, HarnessError> {
     // The names in `methods` are checked against the run's methods (configs/methods.toml and any
     // peers) when the run is prepared.
     Ok(spec)
+}
+
+/// The keys that say where a scenario's mesh comes from: a file that `extends` another and gives
+/// one of them replaces all of the other's.
+const MESH_SOURCE_KEYS: [&str; 5] = ["mesh", "meshes", "manifest", "survey", "procedural"];
+
+/// The TOML table of the scenario file `path`, with what it `extends` filled in: the keys of the
+/// file it names (relative to `path`), each replaced by `path`'s own where it gives it. `depth`
+/// counts the files that extended this one (a chain longer than 8 is taken for a cycle).
+fn read_extended(path: &Path, depth: usize) -> Result<toml::Table, HarnessError> {
+    let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
+    let text = std::fs::read_to_string(path)
+        .map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
+    let mut table: toml::Table = toml::from_str(&text).map_err(|e| config(e.to_string()))?;
+    let Some(extends) = table.remove("extends") else {
+        return Ok(table);
+    };
+    let toml::Value::String(base) = extends else {
+        return Err(config("`extends` is the path of another scenario file".into()));
+    };
+    if depth >= 8 {
+        return Err(config(format!(
+            "`extends = \"{base}\"`: more than 8 files extend each other (a cycle?)"
+        )));
+    }
+    let base_path = path.parent().map(|d| d.join(&base)).unwrap_or_else(|| PathBuf::from(&base));
+    let mut merged = read_extended(&base_path, depth + 1)?;
+    if MESH_SOURCE_KEYS.iter().any(|k| table.contains_key(*k)) {
+        MESH_SOURCE_KEYS.iter().for_each(|k| {
+            merged.remove(*k);
+        });
+    }
+    merged.extend(table);
+    Ok(merged)
 }
 
 /// The first edit of a scenario: its regions, how each moves and its role.
@@ -386,10 +476,16 @@ impl ScenarioSpec {
     }
 
     /// Load the mesh(es) and edit and validate them: one scenario, or one per file of a collection
-    /// (`meshes`), named `<name>-<file stem>`.
-    pub fn load(&self, source: &DataSource) -> Result<Vec<LoadedScenario>, HarnessError> {
+    /// (`meshes` or `[manifest]`), named `<name>-<file stem>`. A file of a collection that cannot
+    /// be loaded or edited (refused at load, a region that selects nothing on it, a component with
+    /// no constrained vertex) is skipped with its reason; the others load. Errors: a single mesh
+    /// that cannot be loaded, a collection that matches no file or whose every file is skipped.
+    pub fn load(&self, source: &DataSource) -> Result<Loaded, HarnessError> {
         let fail = |message: String| HarnessError::Scenario { scenario: self.name.clone(), message };
-        if let Some(pattern) = &self.meshes {
+        let members: Vec<(PathBuf, Vec<(String, String)>)> = if let Some(manifest) = &self.manifest {
+            let entries = manifest.entries(&self.paths(None)).map_err(fail)?;
+            entries.into_iter().map(|e| (e.path, e.columns)).collect()
+        } else if let Some(pattern) = &self.meshes {
             let resolved = self.paths(None).resolve(pattern).map_err(fail)?;
             let text = resolved.to_string_lossy().into_owned();
             let mut paths: Vec<PathBuf> = glob::glob(&text)
@@ -401,21 +497,41 @@ impl ScenarioSpec {
             if paths.is_empty() {
                 return Err(fail(format!("meshes = \"{pattern}\" ({text}) matches no file")));
             }
-            return paths
-                .iter()
-                .map(|p| {
-                    self.files_read.push(p.clone());
-                    let stem = file_stem(p);
-                    self.load_file(p, &format!("{}-{stem}", self.name), Some(stem))
-                })
-                .collect();
-        }
-        if let Some(mesh) = &self.mesh {
+            paths.into_iter().map(|p| (p, Vec::new())).collect()
+        } else if let Some(mesh) = &self.mesh {
             let path = self.paths(None).resolve(mesh).map_err(fail)?;
             let stem = file_stem(&path);
-            return Ok(vec![self.load_file(&path, &self.name, Some(stem))?]);
+            let scenario = self.load_file(&path, &self.name, Some(stem), None)?;
+            return Ok(Loaded { scenarios: vec![scenario], skipped: Vec::new() });
+        } else {
+            return Ok(Loaded { scenarios: vec![self.load_builtin(source)?], skipped: Vec::new() });
+        };
+        let mut loaded = Loaded { scenarios: Vec::new(), skipped: Vec::new() };
+        for (path, attributes) in members {
+            self.files_read.push(path.clone());
+            let stem = file_stem(&path);
+            let name = format!("{}-{stem}", self.name);
+            let member = Member { collection: self.name.clone(), mesh: stem.clone(), attributes };
+            match self.load_file(&path, &name, Some(stem), Some(member.clone())) {
+                Ok(scenario) => loaded.scenarios.push(scenario),
+                Err(e) => loaded.skipped.push(SkippedInput {
+                    scenario: name,
+                    file: path,
+                    reason: skip_reason(&e),
+                    member,
+                }),
+            }
         }
-        Ok(vec![self.load_builtin(source)?])
+        if loaded.scenarios.is_empty() {
+            let first = &loaded.skipped[0];
+            return Err(fail(format!(
+                "every one of its {} meshes was skipped; the first, {}: {}",
+                loaded.skipped.len(),
+                first.file.display(),
+                first.reason
+            )));
+        }
+        Ok(loaded)
     }
 
     /// A survey mesh or procedural look-alike, with the survey edit or the scenario's regions.
@@ -482,6 +598,7 @@ impl ScenarioSpec {
             steps,
             input: None,
             notes: Vec::new(),
+            member: None,
         })
     }
 
@@ -491,6 +608,7 @@ impl ScenarioSpec {
         path: &Path,
         name: &str,
         stem: Option<String>,
+        member: Option<Member>,
     ) -> Result<LoadedScenario, HarnessError> {
         let fail = |message: String| HarnessError::Scenario { scenario: name.to_string(), message };
         let input = meshes::io::read_mesh(path)?;
@@ -533,7 +651,16 @@ impl ScenarioSpec {
         let kept = map.kept().to_vec();
         check_components(&mesh, &steps, Some(&kept)).map_err(|e| fail(format!("{}: {e}", path.display())))?;
         let input = (!dropped.is_empty()).then(|| InputMesh { mesh: input, kept });
-        Ok(LoadedScenario { spec, mesh_source: FILE_SOURCE.to_string(), mesh, topology, steps, input, notes })
+        Ok(LoadedScenario {
+            spec,
+            mesh_source: FILE_SOURCE.to_string(),
+            mesh,
+            topology,
+            steps,
+            input,
+            notes,
+            member,
+        })
     }
 
     /// The steps `build` makes from `mesh` posed in the scenario's [`Frame`], their motions taken

@@ -566,6 +566,7 @@ mod tests {
             }],
             input: None,
             notes: Vec::new(),
+            member: None,
         }
     }
 
