@@ -597,7 +597,7 @@ pub fn turn_to_reference(e: &Evaluation, reference: &[[f64; 3]]) -> f64 {
 }
 
 /// The `fraction` percentile (nearest rank) of `values`; 0 for none.
-fn percentile(mut values: Vec<f64>, fraction: f64) -> f64 {
+pub(crate) fn percentile(mut values: Vec<f64>, fraction: f64) -> f64 {
     if values.is_empty() {
         return 0.0;
     }

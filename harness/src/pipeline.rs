@@ -178,6 +178,10 @@ pub fn publish(
         publish.meshes.every_scenario || s.spec.writes_result_meshes()
     })?;
     report::quality_time::write_markdown(dir, &run.results)?;
+    let dataset = report::dataset::render_markdown(&run.results, &run.skipped);
+    if !dataset.is_empty() {
+        report::dataset::write_markdown(dir, &dataset)?;
+    }
     timed(RunPhase::Reports, start);
 
     let start = Instant::now();
@@ -208,6 +212,7 @@ pub fn publish(
             &outcome,
             &run.notes,
             &viewable,
+            &dataset,
         ),
     )?;
     timed(RunPhase::GateAndIndex, start);

@@ -42,6 +42,7 @@ pub fn render_index(
     gate: &GateOutcome,
     notes: &[String],
     viewable: &[String],
+    dataset: &str,
 ) -> String {
     let mut page = String::new();
     page.push_str(concat!(
@@ -144,13 +145,14 @@ pub fn render_index(
         };
         let _ = write!(
             page,
-            "<tr class=\"{class}\" data-scenario=\"{}\" data-method=\"{}\" data-status=\"{}\" data-source=\"{}\"{}>\
+            "<tr class=\"{class}\" data-scenario=\"{}\" data-method=\"{}\" data-status=\"{}\" data-source=\"{}\"{}{}>\
              <td class=\"text\">{}</td><td class=\"text\">{}{badge}</td><td class=\"text status\">{}</td>\
              <td data-v=\"{}\">{}</td><td data-v=\"{}\">{}</td><td>{}</td>{}{}{}{}{}{}<td data-v=\"{}\">{}</td>",
             escape(&r.scenario),
             escape(&r.method),
             r.status.kind(),
             escape(&r.mesh_source),
+            member_attributes(r),
             {
                 let stem = crate::report::case_file_stem(&r.scenario, &r.method);
                 if viewable.contains(&stem) {
@@ -241,10 +243,28 @@ pub fn render_index(
         page.push_str(&markdown_table(&peers));
     }
 
-    let (figures, plots): (Vec<&PathBuf>, Vec<&PathBuf>) = images
-        .iter()
-        .filter(|p| p.extension().is_some_and(|e| e == "png"))
-        .partition(|p| p.starts_with("figures"));
+    let is_dataset = |p: &&PathBuf| {
+        p.file_name().is_some_and(|n| {
+            let n = n.to_string_lossy();
+            n.starts_with("dataset-") || n.starts_with("worst-")
+        })
+    };
+    let (dataset_images, images): (Vec<&PathBuf>, Vec<&PathBuf>) =
+        images.iter().filter(|p| p.extension().is_some_and(|e| e == "png")).partition(is_dataset);
+    if !dataset.is_empty() {
+        page.push_str(
+            "<h2 id=\"dataset\">Across the dataset</h2>\n<p>The same tables as <code>dataset.md</code>: how often \
+             each method broke per edit family, how its error spreads, what it costs and how that grows with the mesh; \
+             then the error distributions, the cost curves and each family's worst <code>ok</code> results beside arap's. \
+             The results table below filters by family, mesh, surface, genus and size.</p>\n",
+        );
+        page.push_str(&markdown_table(dataset));
+        for p in dataset_images {
+            image(&mut page, p, caption_for(p));
+        }
+    }
+    let (figures, plots): (Vec<&PathBuf>, Vec<&PathBuf>) =
+        images.into_iter().partition(|p| p.starts_with("figures"));
     let (pareto, plots): (Vec<&PathBuf>, Vec<&PathBuf>) =
         plots.into_iter().partition(|p| caption_for(p).ends_with("-pareto"));
     quality_against_time(&mut page, results, &pareto);
@@ -415,6 +435,36 @@ fn image(page: &mut String, path: &Path, caption: String) {
         c = escape(&caption),
         s = escape(&link(&svg)),
     );
+}
+
+/// The data attributes of a collection's case for the page's filters: its edit family and mesh,
+/// and from the mesh's manifest row whether it is closed, its genus (0, 1, 2-4, 5+) and size class
+/// (by vertices: < 5K, 5-30K, 30-100K, >= 100K); nothing for other cases.
+fn member_attributes(case: &CaseResult) -> String {
+    let Some(member) = &case.member else { return String::new() };
+    let mut out =
+        format!(" data-family=\"{}\" data-mesh=\"{}\"", escape(&member.collection), escape(&member.mesh));
+    if let Some(watertight) = member.attribute("watertight") {
+        let surface = if watertight == "true" { "closed" } else { "open or not manifold" };
+        let _ = write!(out, " data-surface=\"{surface}\"");
+    }
+    if let Some(genus) = member.attribute("genus").and_then(|g| g.parse::<f64>().ok()) {
+        let class = match genus {
+            g if g < 0.5 => "0",
+            g if g < 1.5 => "1",
+            g if g < 4.5 => "2-4",
+            _ => "5+",
+        };
+        let _ = write!(out, " data-genus=\"{class}\"");
+    }
+    let size = match case.vertices {
+        v if v < 5_000 => "< 5K",
+        v if v < 30_000 => "5K-30K",
+        v if v < 100_000 => "30K-100K",
+        _ => ">= 100K",
+    };
+    let _ = write!(out, " data-size=\"{}\"", escape(size));
+    out
 }
 
 /// The pipe tables of `markdown` as HTML tables; other lines as paragraphs.

@@ -3,6 +3,7 @@
 //! ([`run_comparison`]), the pictures ([`render`]), the 3D view's mesh files ([`viewer`]), the HTML
 //! page ([`html`]) and the font they share ([`fonts`]). Each writer renders in memory first and writes its files atomically.
 
+pub mod dataset;
 pub mod fonts;
 pub mod html;
 pub mod peer_comparison;

@@ -55,7 +55,11 @@
   });
 
   // ---- Filtering by test, method, status and data source (the rows' data attributes).
-  var filters = [['scenario', 'test'], ['method', 'method'], ['status', 'status'], ['source', 'data source']];
+  // The dataset's (a collection's cases): edit family, mesh, open or closed, genus and size class;
+  // a filter no row has a value for is left out.
+  var filters = [['scenario', 'test'], ['method', 'method'], ['status', 'status'], ['source', 'data source'],
+    ['family', 'edit family'], ['mesh', 'mesh'], ['surface', 'surface'], ['genus', 'genus'], ['size', 'size']]
+    .filter(function (f) { return rows.some(function (r) { return r.dataset[f[0]] !== undefined; }); });
   var chosen = {};
   var filterBox = document.getElementById('filters');
   var counter = document.createElement('span');
@@ -72,7 +76,9 @@
   filters.forEach(function (f) {
     var key = f[0];
     var values = [];
-    rows.forEach(function (r) { if (values.indexOf(r.dataset[key]) < 0) values.push(r.dataset[key]); });
+    rows.forEach(function (r) {
+      if (r.dataset[key] !== undefined && values.indexOf(r.dataset[key]) < 0) values.push(r.dataset[key]);
+    });
     var label = document.createElement('label');
     label.textContent = f[1] + ' ';
     var select = document.createElement('select');

@@ -30,6 +30,8 @@ use crate::metrics::{MetricSpec, METRICS};
 const SIZE: (u32, u32) = (960, 540);
 /// Pixel size of the errors plot (one panel per plotted metric, side by side).
 const ERRORS_SIZE: (u32, u32) = (1500, 560);
+/// Pixel size of the dataset's ECDF plot (two by two measures).
+const ECDF_SIZE: (u32, u32) = (1500, 1100);
 /// Pixel size of the quality–time plot (three measures by two time axes).
 const PARETO_SIZE: (u32, u32) = (1600, 1500);
 
@@ -81,6 +83,8 @@ pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, H
         }
     }
     let swept = crate::report::quality_time::swept_scenarios(results);
+    // A collection's cases are summed up by the dataset plots below, not one plot set per mesh.
+    scenarios.retain(|s| results.iter().any(|r| r.scenario == *s && r.member.is_none()));
     for scenario in scenarios {
         let cases: Vec<&CaseResult> = results.iter().filter(|r| r.scenario == scenario).collect();
         written.extend(save(dir, &format!("{scenario}-errors"), &Plot::Errors(scenario, &cases))?);
@@ -105,6 +109,11 @@ pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, H
     if !handle_scenarios.is_empty() {
         written.extend(save(dir, "table1", &Plot::Table1(&handle_scenarios))?);
     }
+    let dataset = crate::report::dataset::dataset_cases(results);
+    if !dataset.is_empty() {
+        written.extend(save(dir, "dataset-ecdf", &Plot::DatasetEcdf(&dataset))?);
+        written.extend(save(dir, "dataset-cost", &Plot::DatasetCost(&dataset))?);
+    }
     Ok(written)
 }
 
@@ -119,6 +128,10 @@ enum Plot<'a> {
     Scaling(&'a [&'a CaseResult]),
     Table1(&'a [&'a CaseResult]),
     Pareto(&'a str, &'a [&'a CaseResult]),
+    /// The cases of a dataset run: per measure, the fraction of cases whose error is at most x.
+    DatasetEcdf(&'a [&'a CaseResult]),
+    /// The cases of a dataset run: time per edit and precompute against #V, fitted slopes.
+    DatasetCost(&'a [&'a CaseResult]),
 }
 
 impl Plot<'_> {
@@ -127,6 +140,8 @@ impl Plot<'_> {
         match self {
             Plot::Errors(..) => ERRORS_SIZE,
             Plot::Pareto(..) => PARETO_SIZE,
+            Plot::DatasetEcdf(..) => ECDF_SIZE,
+            Plot::DatasetCost(..) => ERRORS_SIZE,
             _ => SIZE,
         }
     }
@@ -139,6 +154,8 @@ impl Plot<'_> {
             Plot::Scaling(cases) => draw_scaling(root, cases),
             Plot::Table1(cases) => draw_table1(root, cases),
             Plot::Pareto(scenario, cases) => draw_pareto(root, scenario, cases),
+            Plot::DatasetEcdf(cases) => draw_dataset_ecdf(root, cases),
+            Plot::DatasetCost(cases) => draw_dataset_cost(root, cases),
         }
     }
 }
@@ -510,6 +527,151 @@ fn draw_scaling<DB: DrawingBackend>(root: Area<'_, DB>, sweeps: &[&CaseResult]) 
         labelled_line(&mut chart, line(m), color, color.stroke_width(2), m.to_string())?;
     }
     draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, 14)
+}
+
+/// The dataset's error distributions: one panel per measure of
+/// [`crate::report::dataset::SPREAD_MEASURES`], for every method the fraction of its cases (all
+/// that were planned and loaded) whose measure is at most x, on a log x axis. Unfinished and failed
+/// cases never count as reaching x, so a method's curve tops out at its finished fraction.
+fn draw_dataset_ecdf<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult]) -> DrawResult {
+    use crate::report::dataset::{methods_of, SPREAD_MEASURES};
+    root.fill(&WHITE).map_err(err)?;
+    let root = root
+        .titled(
+            "Across the dataset: fraction of cases whose error is at most x (ok or suspect shapes)",
+            ("sans-serif", 22),
+        )
+        .map_err(err)?;
+    let methods = methods_of(cases);
+    for (panel, measure) in root.split_evenly((2, 2)).into_iter().zip(SPREAD_MEASURES) {
+        let curve = |m: &str| -> Vec<(f64, f64)> {
+            let of: Vec<&&CaseResult> = cases.iter().filter(|c| c.method == m).collect();
+            let mut values: Vec<f64> = of
+                .iter()
+                .filter(|c| c.status.is_ok() || c.status.is_suspect())
+                .map(|c| c.metric(measure))
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .collect();
+            values.sort_by(f64::total_cmp);
+            let n = of.len().max(1) as f64;
+            let mut points = Vec::with_capacity(2 * values.len());
+            for (i, v) in values.iter().enumerate() {
+                points.push((*v, i as f64 / n));
+                points.push((*v, (i + 1) as f64 / n));
+            }
+            points
+        };
+        let all: Vec<f64> = methods.iter().flat_map(|m| curve(m)).map(|p| p.0).collect();
+        let (x0, x1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
+        if !x0.is_finite() || x1 <= 0.0 {
+            continue;
+        }
+        let spec = measure.spec();
+        let unit = if spec.unit.is_empty() { String::new() } else { format!(" ({})", spec.unit) };
+        let mut chart = ChartBuilder::on(&panel)
+            .caption(format!("{}{unit}", spec.label), ("sans-serif", 18))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(50)
+            .build_cartesian_2d((x0 * 0.8..x1 * 1.25).log_scale(), 0.0..1.0)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_labels(6)
+            .x_label_formatter(&|v| format!("{}", round_to_two_digits(*v)))
+            .y_desc("fraction of cases")
+            .label_style(("sans-serif", 13))
+            .draw()
+            .map_err(err)?;
+        for m in &methods {
+            let points = curve(m);
+            if points.is_empty() {
+                continue;
+            }
+            let color = method_color(m, cases);
+            let style = color.stroke_width(2);
+            chart
+                .draw_series(LineSeries::new(points, style))
+                .map_err(err)?
+                .label(m.to_string())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
+        }
+        draw_legend(&mut chart, SeriesLabelPosition::LowerRight, 13)?;
+    }
+    Ok(())
+}
+
+/// The dataset's cost against mesh size: time per edit (bind + solve) and precompute against #V on
+/// log-log axes, a dot per case that ran and each method's least-squares line, its slope in the
+/// legend ([`crate::report::dataset::cost_slope`]).
+fn draw_dataset_cost<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult]) -> DrawResult {
+    use crate::report::dataset::{cost_slope, methods_of};
+    root.fill(&WHITE).map_err(err)?;
+    let root = root
+        .titled("Across the dataset: cost against mesh size (log-log, fitted slopes)", ("sans-serif", 22))
+        .map_err(err)?;
+    let methods = methods_of(cases);
+    let axes: [(&str, fn(&CaseResult) -> f64); 2] = [
+        ("time per edit, bind + solve (s)", |c| c.bind_s + c.solve_s),
+        ("precompute (s)", |c| c.precompute_s),
+    ];
+    for (panel, (label, seconds)) in root.split_evenly((1, 2)).into_iter().zip(axes) {
+        let points = |m: &str| -> Vec<(f64, f64)> {
+            cases
+                .iter()
+                .filter(|c| c.method == m && !c.status.is_failed())
+                .map(|c| (c.vertices as f64, seconds(c)))
+                .filter(|(v, t)| *v > 0.0 && t.is_finite() && *t > 0.0)
+                .collect()
+        };
+        let all: Vec<(f64, f64)> = methods.iter().flat_map(|m| points(m)).collect();
+        let (x0, x1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
+        let (y0, y1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
+        if !x0.is_finite() {
+            continue;
+        }
+        let mut chart = ChartBuilder::on(&panel)
+            .caption(label, ("sans-serif", 18))
+            .margin(10)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d((x0 * 0.8..x1 * 1.25).log_scale(), (y0 * 0.5..y1 * 2.0).log_scale())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("vertices")
+            .y_desc("seconds")
+            .x_labels(6)
+            .x_label_formatter(&|v| vertex_count_label(*v))
+            .y_label_formatter(&|v| format!("{}", round_to_two_digits(*v)))
+            .label_style(("sans-serif", 13))
+            .draw()
+            .map_err(err)?;
+        for m in &methods {
+            let p = points(m);
+            if p.is_empty() {
+                continue;
+            }
+            let color = method_color(m, cases);
+            chart.draw_series(p.iter().map(|q| Circle::new(*q, 2, color.mix(0.5).filled()))).map_err(err)?;
+            let (slope, _) = cost_slope(p.iter().map(|(v, t)| (*v as usize, *t)));
+            if !slope.is_finite() {
+                continue;
+            }
+            let n = p.len() as f64;
+            let (mx, my) = p.iter().fold((0.0, 0.0), |(a, b), (v, t)| (a + v.ln() / n, b + t.ln() / n));
+            let (lo, hi) = p.iter().fold((f64::INFINITY, 0.0f64), |(a, b), q| (a.min(q.0), b.max(q.0)));
+            let fit = |v: f64| (my + slope * (v.ln() - mx)).exp();
+            let style = color.stroke_width(2);
+            chart
+                .draw_series(LineSeries::new(vec![(lo, fit(lo)), (hi, fit(hi))], style))
+                .map_err(err)?
+                .label(format!("{m} (slope {slope:.2})"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
+        }
+        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, 13)?;
+    }
+    Ok(())
 }
 
 /// A vertex count for an axis: `6K`, `50K`, `1.2M`.

@@ -87,6 +87,7 @@ pub fn write_figures(
         .filter(|s| results.iter().any(|r| r.scenario == s.spec.name))
         .map(|scenario| Row {
             scenario,
+            label: None,
             cases: columns
                 .iter()
                 .map(|m| results.iter().find(|r| r.scenario == scenario.spec.name && &r.method == m))
@@ -110,13 +111,26 @@ pub fn write_figures(
             }
         }
     }
-    let grids = [(Kind::Shaded, "grid.png"), (Kind::Heat, "grid_heat.png"), (Kind::Area, "grid_area.png")]
-        .map(|(kind, name)| {
+    let grid_kinds: &[(Kind, &str)] = if rows.len() <= MAX_GRID_ROWS {
+        &[(Kind::Shaded, "grid.png"), (Kind::Heat, "grid_heat.png"), (Kind::Area, "grid_area.png")]
+    } else {
+        &[]
+    };
+    let mut grids = grid_kinds
+        .iter()
+        .map(|&(kind, name)| {
             grid_image(&rows, &rendered, &columns, kind)
-                .map(|image| (name, image))
+                .map(|image| (name.to_string(), image))
                 .map_err(|e| HarnessError::Report(format!("{}: {e}", figures.join(name).display())))
-        });
-    let grids = grids.into_iter().collect::<Result<Vec<_>, _>>()?;
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    for (family, (sheet_rows, sheet_rendered)) in worst_sheets(results, &rows, &rendered) {
+        let name = format!("worst-{}.png", crate::report::file_name(&family));
+        let columns = ["result".to_string(), crate::suite::REFERENCE_METHOD.to_string()];
+        let image = grid_image(&sheet_rows, &sheet_rendered, &columns, Kind::Shaded)
+            .map_err(|e| HarnessError::Report(format!("{}: {e}", figures.join(&name).display())))?;
+        grids.push((name, image));
+    }
     for (name, image) in &grids {
         files.push((Path::new(FIGURES).join(name), image));
     }
@@ -136,9 +150,65 @@ pub fn write_figures(
     Ok(files.into_iter().map(|(path, _)| path).collect())
 }
 
-/// One grid row: a scenario and its case per column (`None`: not run).
+/// The most tests a run's grids draw: above it (a dataset run: hundreds of meshes x edits) the grids
+/// would be images tens of thousands of pixels tall that nobody can look at, so only the worst-case
+/// sheets and the single renders are written.
+pub const MAX_GRID_ROWS: usize = 60;
+
+/// Per edit family of a dataset run ([`crate::report::dataset::worst_ok`]), the rows of its
+/// worst-case sheet: each method's worst `ok` results, each beside the reference's result on the
+/// same mesh (`result`, `arap` columns), labelled `method: mesh`, with the images already rendered
+/// for the run's own rows.
+fn worst_sheets<'a>(
+    results: &'a [CaseResult],
+    rows: &[Row<'a>],
+    rendered: &[RenderedRow],
+) -> Vec<(String, (Vec<Row<'a>>, Vec<RenderedRow>))> {
+    let cases = crate::report::dataset::dataset_cases(results);
+    let mut sheets: Vec<(String, (Vec<Row>, Vec<RenderedRow>))> = Vec::new();
+    for (family, method, worst) in crate::report::dataset::worst_ok(&cases) {
+        if method == crate::suite::REFERENCE_METHOD {
+            continue;
+        }
+        if sheets.last().is_none_or(|(f, _)| *f != family) {
+            sheets.push((family.clone(), (Vec::new(), Vec::new())));
+        }
+        let (sheet_rows, sheet_rendered) = &mut sheets.last_mut().expect("pushed above").1;
+        for case in worst {
+            let Some(i) = rows.iter().position(|r| r.scenario.spec.name == case.scenario) else { continue };
+            let cell_of = |m: &str| {
+                rows[i]
+                    .cases
+                    .iter()
+                    .position(|c| c.is_some_and(|c| c.method == m))
+                    .map(|k| (rows[i].cases[k], rendered[i].cells[k].clone()))
+            };
+            let (Some((result, result_cell)), reference) =
+                (cell_of(&method), cell_of(crate::suite::REFERENCE_METHOD))
+            else {
+                continue;
+            };
+            let (reference, reference_cell) = reference.unwrap_or((None, Cell::NotRun));
+            let mesh = case.member.as_ref().map_or(case.scenario.as_str(), |m| m.mesh.as_str());
+            sheet_rows.push(Row {
+                scenario: rows[i].scenario,
+                label: Some(format!("{method}: {mesh}")),
+                cases: vec![result, reference],
+            });
+            sheet_rendered.push(RenderedRow {
+                rest: rendered[i].rest.clone(),
+                cells: vec![result_cell, reference_cell],
+            });
+        }
+    }
+    sheets
+}
+
+/// One grid row: a scenario and its case per column (`None`: not run), labelled with `label` (else
+/// the scenario's name).
 struct Row<'a> {
     scenario: &'a LoadedScenario,
+    label: Option<String>,
     cases: Vec<Option<&'a CaseResult>>,
 }
 
@@ -148,6 +218,7 @@ struct RenderedRow {
     cells: Vec<Cell>,
 }
 
+#[derive(Clone)]
 enum Cell {
     NotRun,
     Failed,
@@ -265,7 +336,10 @@ fn grid_image(
 ) -> Result<RgbImage, String> {
     let label_w = rows
         .iter()
-        .map(|r| Label::new(&r.scenario.spec.name, NAME_PX, INK, (0.0, 0.0), Align::Left).width())
+        .map(|r| {
+            let name = r.label.as_deref().unwrap_or(&r.scenario.spec.name);
+            Label::new(name, NAME_PX, INK, (0.0, 0.0), Align::Left).width()
+        })
         .chain([Label::new("procedural look-alike", DETAIL_PX, INK, (0.0, 0.0), Align::Left).width()])
         .try_fold(120.0f64, |w, l| l.map(|l| w.max(l)))?
         .ceil() as u32
@@ -326,7 +400,7 @@ fn grid_image(
         let (top, mid) = (cell_y(r as u32), cell_y(r as u32) + CELL_SIZE as i64 / 2);
         let scenario = row.scenario;
         labels.push(Label::new(
-            &scenario.spec.name,
+            row.label.as_deref().unwrap_or(&scenario.spec.name),
             NAME_PX,
             INK,
             (PAD as f64, mid as f64 - 6.0),

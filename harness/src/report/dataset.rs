@@ -1,0 +1,393 @@
+//! The answer across a dataset (issue 36): for the cases of collections (scenarios with a
+//! [`Member`]: an edit family run over many meshes), `dataset.md` and the page's section with
+//! - robustness: per family and method, how many cases were ok / suspect / unfinished / failed,
+//!   and how many meshes were skipped before any method ran;
+//! - error spread: per family and method, the median and 90th percentile of E_theta, E_phi, e_area
+//!   and the RMS distance to arap, over the cases with a finished shape (ok or suspect);
+//! - cost: the median time per edit (bind + solve) and with the precompute, and the fitted slope
+//!   of log time against log #V ([`cost_slope`]), the cost growth the papers claim;
+//! - rank: each method's median rank by E_phi among the methods run on the same mesh and edit
+//!   ([`ranks`]).
+//! The plots (ECDFs, cost against #V) are in [`super::plots`], the worst-case sheets in
+//! [`super::render`].
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use crate::case::CaseResult;
+use crate::metrics::{percentile, Metric};
+use crate::pareto::TimeAxis;
+use crate::scenario::SkippedInput;
+use crate::verdict::STATUS_KINDS;
+
+/// The measures whose spread the report gives, lower is better for each.
+pub const SPREAD_MEASURES: [Metric; 4] = [Metric::ETheta, Metric::EPhi, Metric::EArea, Metric::RmsToArap];
+
+/// How many of a method's worst `ok` cases per family a worst-case sheet shows.
+pub const WORST_PER_METHOD: usize = 5;
+
+/// The measure worst-case sheets and ranks order by.
+pub const RANK_MEASURE: Metric = Metric::EPhi;
+
+/// The cases of `results` that belong to a collection, if any.
+pub fn dataset_cases(results: &[CaseResult]) -> Vec<&CaseResult> {
+    results.iter().filter(|r| r.member.is_some()).collect()
+}
+
+/// The collections (families) of `cases`, in order of first appearance.
+pub fn families<'a>(cases: &[&'a CaseResult]) -> Vec<&'a str> {
+    let mut out: Vec<&str> = Vec::new();
+    for c in cases {
+        let family = c.member.as_ref().map_or("", |m| m.collection.as_str());
+        if !out.contains(&family) {
+            out.push(family);
+        }
+    }
+    out
+}
+
+/// The methods of `cases`, in order of first appearance (the run's plan order).
+pub fn methods_of<'a>(cases: &[&'a CaseResult]) -> Vec<&'a str> {
+    let mut out: Vec<&str> = Vec::new();
+    for c in cases {
+        if !out.contains(&c.method.as_str()) {
+            out.push(&c.method);
+        }
+    }
+    out
+}
+
+fn family_of(case: &CaseResult) -> &str {
+    case.member.as_ref().map_or("", |m| m.collection.as_str())
+}
+
+/// Whether a case left a finished shape to measure (ok or suspect).
+fn finished(case: &CaseResult) -> bool {
+    case.status.is_ok() || case.status.is_suspect()
+}
+
+/// Median and 90th percentile (nearest rank) of the finite values; NaN for none.
+pub fn median_and_p90(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let values: Vec<f64> = values.filter(|v| v.is_finite()).collect();
+    if values.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    (percentile(values.clone(), 0.5), percentile(values, 0.9))
+}
+
+/// The least-squares slope of `ln time` against `ln vertices` over the points with a positive,
+/// finite time, and how many there were; NaN with fewer than 3 points or one mesh size only.
+pub fn cost_slope(points: impl Iterator<Item = (usize, f64)>) -> (f64, usize) {
+    let logs: Vec<(f64, f64)> = points
+        .filter(|(v, t)| *v > 0 && t.is_finite() && *t > 0.0)
+        .map(|(v, t)| ((v as f64).ln(), t.ln()))
+        .collect();
+    let n = logs.len();
+    if n < 3 {
+        return (f64::NAN, n);
+    }
+    let (mx, my) = logs.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n as f64, b + y / n as f64));
+    let sxx: f64 = logs.iter().map(|(x, _)| (x - mx) * (x - mx)).sum();
+    let sxy: f64 = logs.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+    (if sxx > 0.0 { sxy / sxx } else { f64::NAN }, n)
+}
+
+/// Each case's rank by [`RANK_MEASURE`] among the cases of its scenario (1 = best): cases with a
+/// finished shape in order of the measure (ties share the better rank), then every unfinished or
+/// failed case at the last rank (the number of cases of the scenario). Keyed by (scenario, method).
+pub fn ranks(cases: &[&CaseResult]) -> BTreeMap<(String, String), usize> {
+    let mut by_scenario: BTreeMap<&str, Vec<&CaseResult>> = BTreeMap::new();
+    for c in cases {
+        by_scenario.entry(&c.scenario).or_default().push(c);
+    }
+    let mut out = BTreeMap::new();
+    for (scenario, group) in by_scenario {
+        let value = |c: &CaseResult| if finished(c) { c.metric(RANK_MEASURE) } else { f64::NAN };
+        for c in &group {
+            let v = value(c);
+            let rank =
+                if v.is_finite() { 1 + group.iter().filter(|o| value(o) < v).count() } else { group.len() };
+            out.insert((scenario.to_string(), c.method.clone()), rank);
+        }
+    }
+    out
+}
+
+/// For each family, each method's [`WORST_PER_METHOD`] `ok` cases with the largest
+/// [`RANK_MEASURE`], worst first: (family, method, cases).
+pub fn worst_ok<'a>(cases: &[&'a CaseResult]) -> Vec<(String, String, Vec<&'a CaseResult>)> {
+    let mut out = Vec::new();
+    for family in families(cases) {
+        for method in methods_of(cases) {
+            let mut ok: Vec<&CaseResult> = cases
+                .iter()
+                .copied()
+                .filter(|c| family_of(c) == family && c.method == method && c.status.is_ok())
+                .filter(|c| c.metric(RANK_MEASURE).is_finite())
+                .collect();
+            ok.sort_by(|a, b| b.metric(RANK_MEASURE).total_cmp(&a.metric(RANK_MEASURE)));
+            ok.truncate(WORST_PER_METHOD);
+            if !ok.is_empty() {
+                out.push((family.to_string(), method.to_string(), ok));
+            }
+        }
+    }
+    out
+}
+
+/// A number for a table: 3 significant digits, `–` for NaN.
+fn num(v: f64) -> String {
+    if !v.is_finite() {
+        "–".into()
+    } else if v == 0.0 {
+        "0".into()
+    } else if v.abs() >= 100.0 {
+        format!("{v:.0}")
+    } else {
+        let digits = (2 - v.abs().log10().floor() as i32).clamp(0, 6) as usize;
+        format!("{v:.digits$}")
+    }
+}
+
+/// Seconds as a short time: `12 ms`, `3.4 s`.
+fn time(s: f64) -> String {
+    if !s.is_finite() {
+        "–".into()
+    } else if s < 1.0 {
+        format!("{} ms", num(s * 1e3))
+    } else {
+        format!("{} s", num(s))
+    }
+}
+
+/// `dataset.md`: every table of the module doc, for the dataset cases of `results` and the
+/// `skipped` meshes; empty when the run has no collection.
+pub fn render_markdown(results: &[CaseResult], skipped: &[SkippedInput]) -> String {
+    let cases = dataset_cases(results);
+    if cases.is_empty() {
+        return String::new();
+    }
+    let families = families(&cases);
+    let methods = methods_of(&cases);
+    let meshes: std::collections::BTreeSet<&str> =
+        cases.iter().filter_map(|c| c.member.as_ref().map(|m| m.mesh.as_str())).collect();
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "# Across the dataset\n\n{} cases: {} edit families × {} methods on {} meshes that ran; {} (family, mesh) \
+         pairs skipped before any method ran (listed at the end).\n",
+        cases.len(),
+        families.len(),
+        methods.len(),
+        meshes.len(),
+        skipped.len()
+    );
+
+    md.push_str("## Robustness\n\nCases per status (ok / suspect / unfinished / failed), and the meshes of the family skipped at load (every method alike).\n\n");
+    let _ = write!(md, "| method |");
+    for f in &families {
+        let _ = write!(md, " {f} |");
+    }
+    md.push_str(" all |\n|---|");
+    md.push_str(&"---|".repeat(families.len() + 1));
+    md.push('\n');
+    for m in &methods {
+        let _ = write!(md, "| {m} |");
+        let counts = |family: Option<&str>| {
+            let of: Vec<&&CaseResult> =
+                cases.iter().filter(|c| c.method == *m && family.is_none_or(|f| family_of(c) == f)).collect();
+            STATUS_KINDS
+                .iter()
+                .map(|k| of.iter().filter(|c| c.status.kind() == *k).count().to_string())
+                .collect::<Vec<_>>()
+                .join(" / ")
+        };
+        for f in &families {
+            let _ = write!(md, " {} |", counts(Some(f)));
+        }
+        let _ = writeln!(md, " {} |", counts(None));
+    }
+    let _ = write!(md, "| skipped meshes |");
+    for f in &families {
+        let _ = write!(md, " {} |", skipped.iter().filter(|s| s.member.collection == *f).count());
+    }
+    let _ = writeln!(md, " {} |\n", skipped.len());
+
+    let ranks = ranks(&cases);
+    md.push_str(
+        "## Error spread, cost and rank\n\nMedian and 90th percentile over the cases with a finished shape \
+         (ok or suspect); times are medians over the cases that ran (failed ones have none); rank by E_phi \
+         among the methods on the same mesh and edit (1 = best; unfinished and failed cases take the last rank).\n\n",
+    );
+    let header =
+        SPREAD_MEASURES.iter().map(|m| format!(" {} median / p90 |", m.spec().label)).collect::<String>();
+    for family in families.iter().map(|f| Some(*f)).chain([None]) {
+        let _ = writeln!(md, "### {}\n", family.unwrap_or("all families"));
+        let _ = writeln!(md, "| method | finished |{header} time per edit | with precompute | median rank |");
+        md.push_str(&"|---".repeat(SPREAD_MEASURES.len() + 5));
+        md.push_str("|\n");
+        for m in &methods {
+            let of: Vec<&CaseResult> = cases
+                .iter()
+                .copied()
+                .filter(|c| c.method == *m && family.is_none_or(|f| family_of(c) == f))
+                .collect();
+            let done: Vec<&CaseResult> = of.iter().copied().filter(|c| finished(c)).collect();
+            let _ = write!(md, "| {m} | {} of {} |", done.len(), of.len());
+            for measure in SPREAD_MEASURES {
+                let (median, p90) = median_and_p90(done.iter().map(|c| c.metric(measure)));
+                let _ = write!(md, " {} / {} |", num(median), num(p90));
+            }
+            let ran = || of.iter().filter(|c| !c.status.is_failed());
+            let (edit, _) = median_and_p90(ran().map(|c| TimeAxis::Edit.seconds(c)));
+            let (with, _) = median_and_p90(ran().map(|c| TimeAxis::WithPrecompute.seconds(c)));
+            let rank: Vec<f64> = of
+                .iter()
+                .filter_map(|c| ranks.get(&(c.scenario.clone(), c.method.clone())))
+                .map(|&r| r as f64)
+                .collect();
+            let (rank, _) = median_and_p90(rank.into_iter());
+            let _ = writeln!(md, " {} | {} | {} |", time(edit), time(with), num(rank));
+        }
+        md.push('\n');
+    }
+
+    md.push_str(
+        "## Cost growth\n\nLeast-squares slope of log time against log #V over every case of the method that ran \
+         (all families): 1 is linear in the mesh size. The reduced models claim a per-iteration cost \
+         independent of #V (slope near 0) and pay for it in the precompute.\n\n\
+         | method | cases | time per edit | per iteration | precompute |\n|---|---|---|---|---|\n",
+    );
+    for m in &methods {
+        let of: Vec<&CaseResult> =
+            cases.iter().copied().filter(|c| c.method == *m && !c.status.is_failed()).collect();
+        let slope = |t: &dyn Fn(&CaseResult) -> f64| cost_slope(of.iter().map(|c| (c.vertices, t(c)))).0;
+        let _ = writeln!(
+            md,
+            "| {m} | {} | {} | {} | {} |",
+            of.len(),
+            num(slope(&|c| TimeAxis::Edit.seconds(c))),
+            num(slope(&|c| c.median_iteration_ms)),
+            num(slope(&|c| c.precompute_s))
+        );
+    }
+
+    md.push_str("\n## Worst ok results\n\nPer family, each method's five `ok` cases with the largest E_phi (the sheets `figures/worst-<family>.png` draw them beside arap's result): garbage called ok is one look away.\n\n");
+    for (family, method, worst) in worst_ok(&cases) {
+        let list = worst
+            .iter()
+            .map(|c| {
+                format!(
+                    "{} ({}°)",
+                    c.member.as_ref().map_or("", |m| m.mesh.as_str()),
+                    num(c.metric(RANK_MEASURE))
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", ");
+        let _ = writeln!(md, "- {family} / {method}: {list}");
+    }
+
+    let failed: Vec<&&CaseResult> = cases.iter().filter(|c| c.status.is_failed()).collect();
+    if !failed.is_empty() {
+        md.push_str("\n## Failed cases\n\n");
+        for c in failed {
+            let _ = writeln!(md, "- {} / {}: {}", c.scenario, c.method, c.status);
+        }
+    }
+    if !skipped.is_empty() {
+        md.push_str("\n## Skipped meshes\n\n");
+        for s in skipped {
+            let _ = writeln!(md, "- skipped: {} ({}): {}", s.scenario, s.file.display(), s.reason);
+        }
+    }
+    md
+}
+
+/// Write `dataset.md` (`markdown`, from [`render_markdown`]) under `dir`, atomically.
+pub fn write_markdown(dir: &std::path::Path, markdown: &str) -> Result<(), crate::error::HarnessError> {
+    meshes::io::atomic_write(dir.join("dataset.md"), |w| {
+        w.write_all(markdown.as_bytes()).map_err(meshes::MeshError::from)
+    })
+    .map_err(crate::error::HarnessError::from)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::Member;
+    use crate::verdict::Status;
+
+    fn case(
+        family: &str,
+        mesh: &str,
+        method: &str,
+        vertices: usize,
+        e_phi: f64,
+        status: Status,
+    ) -> CaseResult {
+        let mut c = CaseResult::empty(&format!("{family}-{mesh}"), method, "file", vertices, 2 * vertices);
+        c.member = Some(Member { collection: family.into(), mesh: mesh.into(), attributes: Vec::new() });
+        c.quality.set(Metric::EPhi, e_phi.is_finite().then_some(e_phi));
+        c.status = status;
+        c
+    }
+
+    #[test]
+    fn the_cost_slope_of_a_power_law_is_its_exponent() {
+        let points = [1_000usize, 4_000, 16_000, 64_000].map(|v| (v, 3e-6 * (v as f64).powf(1.5)));
+        let (slope, n) = cost_slope(points.into_iter());
+        assert!((slope - 1.5).abs() < 1e-12 && n == 4, "{slope}");
+        let (slope, n) = cost_slope([(1_000usize, 0.1), (2_000, f64::NAN)].into_iter());
+        assert!(slope.is_nan() && n == 1);
+    }
+
+    #[test]
+    fn ranks_put_unfinished_and_failed_cases_last_and_ties_share() {
+        let cases = [
+            case("bend", "a", "arap", 10, 1.0, Status::Ok),
+            case("bend", "a", "hirm", 10, 3.0, Status::Suspect(vec!["folds".into()])),
+            case("bend", "a", "laplacian", 10, 1.0, Status::Ok),
+            case("bend", "a", "isolines", 10, 0.5, Status::Unfinished(vec!["cap".into()])),
+            case("bend", "a", "spectral_mhb", 10, f64::NAN, Status::Failed("x".into())),
+        ];
+        let refs: Vec<&CaseResult> = cases.iter().collect();
+        let r = ranks(&refs);
+        let rank = |m: &str| r[&("bend-a".to_string(), m.to_string())];
+        assert_eq!(
+            [rank("arap"), rank("laplacian"), rank("hirm"), rank("isolines"), rank("spectral_mhb")],
+            [1, 1, 3, 5, 5]
+        );
+    }
+
+    #[test]
+    fn worst_sheets_take_the_largest_e_phi_of_ok_cases_only() {
+        let mut cases: Vec<CaseResult> =
+            (0..8).map(|i| case("twist", &format!("m{i}"), "hirm", 100, i as f64, Status::Ok)).collect();
+        cases.push(case("twist", "bad", "hirm", 100, 90.0, Status::Suspect(vec!["folds".into()])));
+        let refs: Vec<&CaseResult> = cases.iter().collect();
+        let worst = worst_ok(&refs);
+        assert_eq!(worst.len(), 1);
+        let meshes: Vec<&str> = worst[0].2.iter().map(|c| c.member.as_ref().unwrap().mesh.as_str()).collect();
+        assert_eq!(meshes, ["m7", "m6", "m5", "m4", "m3"]);
+    }
+
+    #[test]
+    fn the_robustness_table_counts_statuses_and_skipped_meshes() {
+        let cases = [
+            case("bend", "a", "arap", 10, 1.0, Status::Ok),
+            case("bend", "b", "arap", 10, 1.0, Status::Failed("x".into())),
+        ];
+        let skipped = [SkippedInput {
+            scenario: "bend-c".into(),
+            file: "c.obj".into(),
+            reason: "face 3: zero area".into(),
+            member: Member { collection: "bend".into(), mesh: "c".into(), attributes: Vec::new() },
+        }];
+        let md = render_markdown(&cases, &skipped);
+        assert!(md.contains("| arap | 1 / 0 / 0 / 1 | 1 / 0 / 0 / 1 |"), "{md}");
+        assert!(md.contains("| skipped meshes | 1 | 1 |"), "{md}");
+        assert!(md.contains("skipped: bend-c (c.obj): face 3: zero area"), "{md}");
+        assert!(render_markdown(&[CaseResult::empty("bar", "arap", "survey", 1, 1)], &[]).is_empty());
+    }
+}
