@@ -1480,6 +1480,24 @@ fn a_manifest_collection_skips_the_meshes_that_cannot_run_and_runs_the_others() 
     let page = std::fs::read_to_string(reports.path().join("index.html")).unwrap();
     assert!(page.contains("skipped `bend-flat`") && page.contains("skipped `bend-two`"));
 
+    // `repair = true` drops the zero-area face: the mesh runs and its record says what changed.
+    let repaired = format!("repair = true\n{}", tier("\"vertices <= 500\""));
+    let configs = configs_with(&[("bend.toml".to_string(), repaired)]);
+    assert_eq!(all_with(configs.path(), reports.path()).unwrap(), std::process::ExitCode::SUCCESS);
+    let json = read_json(&reports.path().join("results.json"));
+    let flat = json["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["scenario"] == "bend-flat")
+        .expect("bend-flat ran");
+    assert_eq!(flat["status"], "ok");
+    let what = flat["member"]["repaired"].as_str().unwrap();
+    // Vertex t0[2] moved onto t0[0]: face 0 and its neighbour across that edge lose their area.
+    assert!(what.starts_with("2 zero-area faces dropped (e.g. face 0)"), "{what}");
+    let dataset = std::fs::read_to_string(reports.path().join("dataset.md")).unwrap();
+    assert!(dataset.contains("- flat: 2 zero-area faces dropped"), "{dataset}");
+
     let configs = configs_with(&[("bend.toml".to_string(), tier("\"category = \\\"pair\\\"\""))]);
     let message = format!("{:#}", all_with(configs.path(), reports.path()).unwrap_err());
     assert!(

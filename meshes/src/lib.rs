@@ -13,6 +13,8 @@
 //! - [`geometry`]: areas, normals, angles, volume; dihedral angles (vector, primitives, topology).
 //! - [`edit`]: vertex status and the affine handle transform of a survey edit (error, vector).
 //! - [`clean`]: unreferenced vertices, duplicates, components (error, mesh).
+//! - [`repair`]: opt-in repair of zero-area and repeated faces, non-manifold edges and orientation
+//!   (error, mesh, primitives).
 //! - [`shapes`]: procedural look-alikes of the survey shapes (error, vector, mesh, edit).
 //! - [`io`]: mesh and edit file formats (error, mesh, geometry, edit).
 
@@ -23,6 +25,7 @@ pub mod geometry;
 pub mod io;
 pub mod mesh;
 mod primitives;
+pub mod repair;
 pub mod shapes;
 pub mod topology;
 pub mod vector;

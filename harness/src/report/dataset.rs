@@ -295,6 +295,19 @@ pub fn render_markdown(results: &[CaseResult], skipped: &[SkippedInput]) -> Stri
             let _ = writeln!(md, "- {} / {}: {}", c.scenario, c.method, c.status);
         }
     }
+    let mut repaired: Vec<(&str, &str)> = cases
+        .iter()
+        .filter_map(|c| c.member.as_ref())
+        .filter_map(|m| m.repaired.as_deref().map(|r| (m.mesh.as_str(), r)))
+        .collect();
+    repaired.sort();
+    repaired.dedup();
+    if !repaired.is_empty() {
+        md.push_str("\n## Repaired meshes (`repair = true`)\n\n");
+        for (mesh, what) in repaired {
+            let _ = writeln!(md, "- {mesh}: {what}");
+        }
+    }
     if !skipped.is_empty() {
         md.push_str("\n## Skipped meshes\n\n");
         for s in skipped {
@@ -327,7 +340,12 @@ mod tests {
         status: Status,
     ) -> CaseResult {
         let mut c = CaseResult::empty(&format!("{family}-{mesh}"), method, "file", vertices, 2 * vertices);
-        c.member = Some(Member { collection: family.into(), mesh: mesh.into(), attributes: Vec::new() });
+        c.member = Some(Member {
+            collection: family.into(),
+            mesh: mesh.into(),
+            attributes: Vec::new(),
+            repaired: None,
+        });
         c.quality.set(Metric::EPhi, e_phi.is_finite().then_some(e_phi));
         c.status = status;
         c
@@ -382,7 +400,12 @@ mod tests {
             scenario: "bend-c".into(),
             file: "c.obj".into(),
             reason: "face 3: zero area".into(),
-            member: Member { collection: "bend".into(), mesh: "c".into(), attributes: Vec::new() },
+            member: Member {
+                collection: "bend".into(),
+                mesh: "c".into(),
+                attributes: Vec::new(),
+                repaired: None,
+            },
         }];
         let md = render_markdown(&cases, &skipped);
         assert!(md.contains("| arap | 1 / 0 / 0 / 1 | 1 / 0 / 0 / 1 |"), "{md}");

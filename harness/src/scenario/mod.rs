@@ -98,6 +98,12 @@ pub struct ScenarioSpec {
     /// rest mesh's principal axes ([`frame`]).
     #[serde(default)]
     pub frame: Frame,
+    /// Repair each mesh file before use ([`meshes::repair`]: zero-area and repeated faces and the
+    /// extra faces of non-manifold edges dropped, orientation made consistent); what it changed is
+    /// a note of the scenario and part of its cases' record. Default `false`: such meshes are
+    /// refused (a collection skips them).
+    #[serde(default)]
+    pub repair: bool,
     /// The regions of the first edit (default for `survey`/`procedural`: the survey selection).
     #[serde(default)]
     pub regions: Vec<RegionSpec>,
@@ -270,6 +276,9 @@ pub struct Member {
     pub mesh: String,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub attributes: Vec<(String, String)>,
+    /// What `repair = true` changed in the mesh, if anything.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repaired: Option<String>,
 }
 
 impl Member {
@@ -511,7 +520,8 @@ impl ScenarioSpec {
             self.files_read.push(path.clone());
             let stem = file_stem(&path);
             let name = format!("{}-{stem}", self.name);
-            let member = Member { collection: self.name.clone(), mesh: stem.clone(), attributes };
+            let member =
+                Member { collection: self.name.clone(), mesh: stem.clone(), attributes, repaired: None };
             match self.load_file(&path, &name, Some(stem), Some(member.clone())) {
                 Ok(scenario) => loaded.scenarios.push(scenario),
                 Err(e) => loaded.skipped.push(SkippedInput {
@@ -611,9 +621,21 @@ impl ScenarioSpec {
         member: Option<Member>,
     ) -> Result<LoadedScenario, HarnessError> {
         let fail = |message: String| HarnessError::Scenario { scenario: name.to_string(), message };
-        let input = meshes::io::read_mesh(path)?;
-        let (mesh, map) = meshes::clean::drop_unreferenced(&input);
+        let mut input = meshes::io::read_mesh(path)?;
         let mut notes = Vec::new();
+        let mut member = member;
+        if self.repair {
+            // Results are then written with the repaired faces, in the file's vertex order.
+            let (repaired, log) = meshes::repair::repair(&input).map_err(|e| e.in_file(path))?;
+            if !log.is_empty() {
+                notes.push(format!("{}: repaired: {}", path.display(), log.summary()));
+                if let Some(m) = &mut member {
+                    m.repaired = Some(log.summary());
+                }
+            }
+            input = repaired;
+        }
+        let (mesh, map) = meshes::clean::drop_unreferenced(&input);
         let dropped = map.dropped();
         if !dropped.is_empty() {
             notes.push(format!(
