@@ -32,6 +32,10 @@ pub enum MethodError {
     NonFiniteResult { method: String, vertex: usize },
     #[error("external method `{method}`: {message}")]
     External { method: String, message: String },
+    /// A method's own dense system that should be positive definite by construction failed to
+    /// factor: which matrix, and what makes it singular.
+    #[error("`{method}`: {matrix} is not numerically positive definite: {reason}")]
+    NotPositiveDefinite { method: &'static str, matrix: String, reason: String },
     #[error("`{method}` diverged: iteration {iteration} moved a vertex {step:.3e} bounding-box diagonals")]
     Diverged { method: &'static str, iteration: usize, step: f64 },
 }

@@ -311,3 +311,77 @@ fn a_bind_that_keeps_the_previous_regions_gives_the_whole_system() {
         "kept-term factor differs from the whole build by {largest:e} (of {scale:e})"
     );
 }
+
+/// A flat mesh (z = 0 everywhere, like the dataset's 2D `alligator.obj`): `W` of eq 9 does not see
+/// the out-of-plane row of the transforms, so `U^T U` of eq 26 had an exact null vector and the
+/// handle update's factorization failed or passed by rounding (on `alligator.obj` it failed for
+/// every edit). With the plane gauge it is definite, the rest shape is a fixed point, and the strip
+/// bends out of its plane with its handles where they are asked to be.
+#[test]
+fn a_flat_mesh_binds_and_bends_out_of_its_plane() {
+    let flat = strip(4.5, 45);
+    let diagonal = flat.bbox_diagonal();
+    let n = flat.n_vertices() as u32;
+    let end = |from: f64, to: f64| -> Vec<u32> {
+        (0..n).filter(|&v| (from..=to).contains(&flat.positions()[v as usize][0])).collect()
+    };
+    let handles = HandleSet::new(
+        vec![
+            HandleRegion { name: "fixed".into(), vertices: end(0.0, 0.4) },
+            HandleRegion { name: "handle".into(), vertices: end(4.1, 4.5) },
+        ],
+        flat.n_vertices(),
+    )
+    .unwrap();
+    let mut hirm = Hirm::new(HirmParams::default()).unwrap();
+    hirm.precompute(&flat).unwrap();
+    // U^T U is definite well above the rounding (before the gauge: the smallest eigenvalue was
+    // ~1e-18 of the largest, of either sign).
+    let built = handle_independent_model(flat.positions(), &hirm.system_inputs().unwrap());
+    assert!(built.plane_gauge_rhs.is_some(), "the flat strip is planar");
+    let normal = built.system.constrained_normal_matrix(&built.model, &handles, 1000.0);
+    let eigenvalues = normal.self_adjoint_eigen(faer::Side::Lower).unwrap().S().column_vector().to_owned();
+    let (smallest, largest) = (eigenvalues[0], eigenvalues[eigenvalues.nrows() - 1]);
+    assert!(smallest > 1e-14 * largest, "U^T U: smallest eigenvalue {smallest:e} of {largest:e}");
+
+    hirm.bind_handles(&handles).unwrap();
+    let summary = hirm.solve(&targets(&handles, flat.positions(), [0.0; 3]), &mut NoObserver).unwrap();
+    let moved = methods::method::max_displacement(&hirm.positions(), flat.positions());
+    assert!(moved < FIXED_POINT * diagonal, "rest shape moved by {moved}");
+    assert!(summary.converged && summary.iterations <= 2, "{summary:?}");
+
+    // The moved end turned 45 degrees about the y axis through its middle, out of the plane.
+    let (c, s) = (std::f64::consts::FRAC_PI_4.cos(), std::f64::consts::FRAC_PI_4.sin());
+    let rest = flat.positions();
+    let turned: Vec<[f64; 3]> = handles
+        .regions()
+        .iter()
+        .flat_map(|r| r.vertices.iter().map(move |&v| (r.name == "handle", rest[v as usize])))
+        .map(|(moved, p)| if moved { [4.3 + c * (p[0] - 4.3), p[1], s * (p[0] - 4.3)] } else { p })
+        .collect();
+    let summary =
+        hirm.solve(&HandleTargets::new(&handles, turned.clone()).unwrap(), &mut NoObserver).unwrap();
+    assert!(summary.converged, "{summary:?}");
+    let result = hirm.positions();
+    let residual = handles
+        .constrained()
+        .zip(&turned)
+        .map(|(v, t)| methods::method::max_displacement(&[result[v as usize]], &[*t]))
+        .fold(0.0, f64::max);
+    assert!(residual < 1e-4 * diagonal, "handle residual {:e} diagonals", residual / diagonal);
+    // The free middle bends out of the plane like a thin plate: the cubic `z(x)` of least bending
+    // that leaves the held end flat (x = 0.4) and meets the turned end's inner edge (x = 4.1) at its
+    // height and 45 degree slope dips below the plane and comes back up, and the mean height of the
+    // strip follows it to 0.1 (2% of the length).
+    let (x0, x1) = (0.4, 4.1);
+    let (z1, slope) = (s * (x1 - 4.3), 1.0);
+    let length = x1 - x0;
+    let b = (slope * length - 2.0 * z1) / length.powi(3);
+    let a = (z1 - b * length.powi(3)) / (length * length);
+    let cubic = |x: f64| a * (x - x0).powi(2) + b * (x - x0).powi(3);
+    for x in [1.0, 2.0, 3.0, 4.0] {
+        let near: Vec<usize> = (0..n as usize).filter(|&v| (rest[v][0] - x).abs() < 0.05).collect();
+        let height = near.iter().map(|&v| result[v][2]).sum::<f64>() / near.len() as f64;
+        assert!((height - cubic(x)).abs() < 0.1, "height {height} at x = {x}, thin plate {}", cubic(x));
+    }
+}

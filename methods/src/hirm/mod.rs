@@ -28,6 +28,14 @@
 //!   smooth on meshes with obtuse triangles.
 //! - Soft constraints `omega^2 |Phi W R - H|^2` on every handle vertex, `omega = 1000` as in
 //!   `laplacian` and `isolines` (the paper gives no weight).
+//! - Gauges: `U^T U` of eq 14-15 (eq 26) is singular as the paper writes it (always through the
+//!   blend, on planar shapes also through `W`), so `T_1` gets two terms that change no position
+//!   ([`background`]): the constant blend weights of eq 8 leave one affine map per field free up
+//!   to their weighted sum (the field gauge), and on a planar base shape (a flat 2D mesh such as
+//!   the dataset's `alligator.obj`, z = 0 everywhere, or a planar mesh edited in its plane) `W` of
+//!   eq 9 does not see the out-of-plane row of the transforms (the plane gauge holds its common
+//!   part at the identity's). Without the latter the handle update's factorization failed on
+//!   `alligator.obj` for every edit.
 //! - `bind_handles` waits for a background precompute still running; the wait is reported
 //!   separately (`bind_background_wait`) from the handle update `t_h`.
 //! - The step size is the largest displacement of the vertices of the sampled triangles.
@@ -431,7 +439,18 @@ impl DeformationMethod for Hirm {
             MemStack::new(&mut self.factor_workspace),
             Default::default(),
         )
-        .map_err(|_| MethodError::Solver(crate::linalg::sparse_cholesky::SolverError::NotPositiveDefinite))?;
+        .map_err(|_| MethodError::NotPositiveDefinite {
+            method: "hirm",
+            matrix: format!(
+                "the reduced normal matrix U^T U of eq 26 ({size} x {size}: 4 x {} isolines of {} fields)",
+                independent.model.n_isolines(),
+                self.rest.as_ref().map_or(0, |r| r.scores.len()),
+            ),
+            reason: "some combination of the isoline transforms moves no handle vertex and no \
+                     Laplacian coordinate (the gauges of the fields and of planar shapes are fixed, \
+                     so this points at degenerate propagation fields or a non-finite shape)"
+                .into(),
+        })?;
         self.set_timing(crate::keys::phase::T_H_HANDLE_UPDATE, start.elapsed().as_secs_f64());
         self.reduced = independent.model.identity_transforms();
         self.bound = Some(Bound { independent, handles: handles.clone() });
@@ -449,8 +468,11 @@ impl DeformationMethod for Hirm {
         targets.check_for(&bound.handles)?;
         let (model, system) = (&bound.independent.model, &bound.independent.system);
         let t0 = Instant::now();
-        // omega^2 W^T Phi^T H of eq 27, once per solve.
-        let constraints = constraint_rhs(model, &bound.handles, targets, self.params.omega);
+        // omega^2 W^T Phi^T H of eq 27, once per solve, and the plane gauge's term (planar bases).
+        let mut constraints = constraint_rhs(model, &bound.handles, targets, self.params.omega);
+        if let Some(gauge) = &bound.independent.plane_gauge_rhs {
+            constraints += gauge;
+        }
         let mut probes = model.probe_positions(self.reduced.as_ref());
         let setup = t0.elapsed().as_secs_f64();
         let tolerance = self.params.tolerance;

@@ -293,6 +293,54 @@ impl IsolineModel {
         self.frame
     }
 
+    /// The direction no row of `W_x` sees when the base shape is planar: the unit homogeneous
+    /// `nu = (n, -n . x_bar_mean) / |..|` with `n` the normal of the base's best-fit plane in the
+    /// model's frame, so that `nu . (x_bar_k, 1) = 0` for every vertex `k`. Then `W_x` maps every
+    /// transform part `nu a^T` (`a` any 3-vector) to zero: the out-of-plane row of the transforms
+    /// moves no vertex. `None` unless every vertex lies within `tolerance` of that plane, in units
+    /// of the base's RMS distance from its centroid; `None` also for an empty or single-point base.
+    pub fn plane_direction(&self, tolerance: f64) -> Option<[f64; 4]> {
+        let n = self.base.len();
+        if n == 0 {
+            return None;
+        }
+        let points: Vec<[f64; 3]> = (0..n)
+            .map(|k| {
+                let h = self.homogeneous(k);
+                [h[0], h[1], h[2]]
+            })
+            .collect();
+        let mut mean = [0.0; 3];
+        for p in &points {
+            for a in 0..3 {
+                mean[a] += p[a] / n as f64;
+            }
+        }
+        let mut covariance = Mat::<f64>::zeros(3, 3);
+        for p in &points {
+            let d = sub(*p, mean);
+            for a in 0..3 {
+                for b in 0..3 {
+                    covariance[(a, b)] += d[a] * d[b] / n as f64;
+                }
+            }
+        }
+        let radius = (0..3).map(|a| covariance[(a, a)]).sum::<f64>().sqrt();
+        if !(radius > 0.0 && radius.is_finite()) {
+            return None;
+        }
+        let evd = covariance.as_ref().self_adjoint_eigen(faer::Side::Lower).ok()?;
+        let smallest = (0..3).min_by(|&i, &j| evd.S()[i].total_cmp(&evd.S()[j]))?;
+        let normal = normalize_or_zero(std::array::from_fn(|a| evd.U()[(a, smallest)]));
+        let offset = -dot(normal, mean);
+        let distance = points.iter().map(|p| (dot(normal, *p) + offset).abs()).fold(0.0, f64::max);
+        if !(distance <= tolerance * radius) || dot(normal, normal) == 0.0 {
+            return None;
+        }
+        let norm = (1.0 + offset * offset).sqrt();
+        Some([normal[0] / norm, normal[1] / norm, normal[2] / norm, offset / norm])
+    }
+
     /// Row `k` of `W_x` before the isoline weights: `x_bar_k = (x_k - c) / l` and 1 (see
     /// [`ModelFrame`]).
     fn homogeneous(&self, k: usize) -> [f64; 4] {
@@ -819,5 +867,65 @@ mod tests {
                 "probe {i}"
             );
         }
+    }
+
+    /// A flat grid, tilted and moved away from the origin, with out-of-plane relief `relief`
+    /// (relative to its size), and a model on it with one field along its length.
+    fn tilted_grid_model(relief: f64) -> (IsolineModel, Vec<[f64; 3]>) {
+        let (nx, ny) = (21, 11);
+        let mut base = Vec::new();
+        for j in 0..ny {
+            for i in 0..nx {
+                let (u, v) = (i as f64 / (nx - 1) as f64 * 2.0, j as f64 / (ny - 1) as f64);
+                let w = relief * (7.0 * u).sin() * (5.0 * v).cos();
+                // The (u, v, w) frame turned about (1, 1, 0) and moved to (10, -4, 3).
+                base.push([
+                    10.0 + 0.8 * u + 0.2 * v + 0.566 * w,
+                    -4.0 + 0.2 * u + 0.8 * v - 0.566 * w,
+                    3.0 - 0.566 * u + 0.566 * v + 0.6 * w,
+                ]);
+            }
+        }
+        let id = |i: usize, j: usize| (j * nx + i) as u32;
+        let triangles: Vec<[u32; 3]> = (0..ny - 1)
+            .flat_map(|j| {
+                (0..nx - 1).flat_map(move |i| {
+                    [[id(i, j), id(i + 1, j), id(i + 1, j + 1)], [id(i, j), id(i + 1, j + 1), id(i, j + 1)]]
+                })
+            })
+            .collect();
+        let fields = Mat::from_fn(base.len(), 1, |k, _| (k % nx) as f64 / (nx - 1) as f64);
+        let frame = ModelFrame::of(&base);
+        let model =
+            IsolineModel::new(frame, &base, &triangles, fields.as_ref(), &SetBlend::PerSet(vec![1.0]), 6, 60);
+        (model, base)
+    }
+
+    #[test]
+    fn a_planar_base_has_a_direction_no_row_of_w_sees() {
+        let (model, base) = tilted_grid_model(0.0);
+        let nu = model.plane_direction(1e-6).expect("a planar grid");
+        let norm = nu.iter().map(|v| v * v).sum::<f64>().sqrt();
+        assert!((norm - 1.0).abs() < 1e-12, "|nu| = {norm}");
+        for k in 0..base.len() {
+            let h = model.homogeneous(k);
+            let seen: f64 = (0..4).map(|c| nu[c] * h[c]).sum();
+            assert!(seen.abs() < 1e-12, "vertex {k}: nu . (x_bar, 1) = {seen:e}");
+        }
+        // So adding nu a^T to every transform moves no vertex.
+        let identity = model.identity_transforms();
+        let shifted =
+            Mat::from_fn(identity.nrows(), 3, |r, a| identity[(r, a)] + [3.0, -2.0, 5.0][a] * nu[r % 4]);
+        let moved = model.positions(shifted.as_ref());
+        for (p, q) in moved.iter().zip(&base) {
+            assert!(norm3(sub(*p, *q)) < 1e-11, "{p:?} against {q:?}");
+        }
+        // Relief within the tolerance is planar, beyond it not.
+        assert!(tilted_grid_model(1e-9).0.plane_direction(1e-6).is_some());
+        assert!(tilted_grid_model(1e-4).0.plane_direction(1e-6).is_none());
+    }
+
+    fn norm3(v: [f64; 3]) -> f64 {
+        dot(v, v).sqrt()
     }
 }
