@@ -1508,3 +1508,65 @@ fn a_manifest_collection_skips_the_meshes_that_cannot_run_and_runs_the_others() 
     let message = format!("{:#}", all_with(configs.path(), reports.path()).unwrap_err());
     assert!(message.contains("no column `genus`"), "{message}");
 }
+
+/// Issue 36: the dataset's smoke set (six small meshes of the 79, every edit family, every method
+/// the families name) runs from its TOML files alone, repairs the mesh with zero-area faces, writes
+/// the dataset report (robustness table, error spread, cost slopes, ECDF and cost plots, one
+/// worst-case sheet per family, the page's section and filters) and passes its committed gate.
+#[test]
+fn the_dataset_smoke_set_runs_every_family_and_passes_its_gate() {
+    let Some(_) = support::dataset_dir() else { return };
+    let reports = tempfile::tempdir().unwrap();
+    let scenarios = support::workspace_root().join("configs/dataset-smoke");
+    let args = [
+        "all",
+        "--quiet",
+        "--scenarios",
+        scenarios.to_str().unwrap(),
+        "--reports",
+        reports.path().to_str().unwrap(),
+    ];
+    let code = run(&args).unwrap();
+    let json = read_json(&reports.path().join("results.json"));
+    let cases = json["cases"].as_array().unwrap();
+    let families = ["bend", "pull", "stretch", "twist", "two-handles"];
+    let meshes = ["africanhead", "alligator", "bamboopen", "block", "goathead", "shark"];
+    let methods = ["laplacian", "arap", "hirm", "spectral_mhb", "scale_aware", "isolines"];
+    assert_eq!(cases.len(), families.len() * meshes.len() * methods.len());
+    assert!(json.get("skipped").is_none(), "every mesh of the smoke set runs (shark repaired)");
+    for c in cases {
+        let member = &c["member"];
+        assert!(families.contains(&member["collection"].as_str().unwrap()), "{member}");
+        assert!(meshes.contains(&member["mesh"].as_str().unwrap()), "{member}");
+        let repaired = member["repaired"].as_str();
+        assert_eq!(repaired.is_some(), member["mesh"] == "shark", "{member}");
+    }
+    assert_eq!(
+        code,
+        std::process::ExitCode::SUCCESS,
+        "no failed case and no regression against the committed gate"
+    );
+
+    let dataset = std::fs::read_to_string(reports.path().join("dataset.md")).unwrap();
+    for method in methods {
+        assert!(dataset.contains(&format!("\n| {method} | ")), "dataset.md has a row for {method}");
+    }
+    for heading in
+        ["## Robustness", "## Error spread, cost and rank", "## Cost growth", "## Worst ok results"]
+    {
+        assert!(dataset.contains(heading), "dataset.md: {heading}");
+    }
+    assert!(dataset.contains("- shark: 4 zero-area faces dropped"), "{dataset}");
+    for file in ["plots/dataset-ecdf.png", "plots/dataset-cost.png", "plots/dataset-cost.svg"] {
+        assert!(reports.path().join(file).is_file(), "{file}");
+    }
+    for family in families {
+        assert!(reports.path().join(format!("figures/worst-{family}.png")).is_file(), "worst-{family}.png");
+    }
+    let page = std::fs::read_to_string(reports.path().join("index.html")).unwrap();
+    assert!(page.contains("id=\"dataset\"") && page.contains("worst-twist.png"));
+    assert!(
+        page.contains("data-family=\"bend\" data-mesh=\"goathead\" data-surface=\"closed\" data-genus=\"0\"")
+    );
+    assert!(page.contains("dataset-smoke.json"), "the run was gated against the smoke set's baseline");
+}

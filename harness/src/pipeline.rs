@@ -24,9 +24,9 @@ pub enum GateRequest {
 
 impl GateRequest {
     /// The gate of a suite run with `options` and an optional `--baseline`: the committed baselines
-    /// cover the default configuration (the workspace's `configs/`, with its scenarios or the
-    /// real-mesh suite `configs/real-meshes`); any other run is compared only with a baseline named
-    /// on purpose.
+    /// cover the default configuration (the workspace's `configs/`, with its scenarios, the
+    /// real-mesh suite `configs/real-meshes` or the dataset's smoke set `configs/dataset-smoke`);
+    /// any other run is compared only with a baseline named on purpose.
     pub fn for_suite(options: &SuiteOptions, baseline: Option<PathBuf>) -> GateRequest {
         let default_configs = suite::workspace_root().join("configs");
         let same = |a: &Path, b: &Path| {
@@ -34,15 +34,16 @@ impl GateRequest {
         };
         let committed_scenarios = match &options.scenarios_dir {
             None => true,
-            Some(dir) => same(dir, &default_configs.join("real-meshes")),
+            Some(dir) => ["real-meshes", "dataset-smoke"].iter().any(|d| same(dir, &default_configs.join(d))),
         };
         if baseline.is_some() {
             GateRequest::Compare(baseline)
         } else if !same(&options.configs_dir, &default_configs) || !committed_scenarios {
             GateRequest::Skip(format!(
-                "the committed baselines cover the scenarios of {} and {} (name one with --baseline)",
+                "the committed baselines cover the scenarios of {}, {} and {} (name one with --baseline)",
                 default_configs.display(),
-                default_configs.join("real-meshes").display()
+                default_configs.join("real-meshes").display(),
+                default_configs.join("dataset-smoke").display()
             ))
         } else {
             GateRequest::Compare(None)

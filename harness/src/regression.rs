@@ -49,14 +49,20 @@ pub enum BaselineKind {
     /// Mesh files only: the real-mesh suite (`configs/real-meshes`), the contract that catches a
     /// method's regressions on real data (issue 35).
     RealMeshes,
+    /// Collections only (every case a [`crate::scenario::Member`]): the dataset's smoke set
+    /// (`configs/dataset-smoke`) that CI runs (issue 36).
+    DatasetSmoke,
 }
 
 impl BaselineKind {
-    /// The kind for a run's `results`: `Survey` if any case ran on a survey mesh, `RealMeshes` if
-    /// every case ran on a mesh file, else `Procedural`.
+    /// The kind for a run's `results`: `Survey` if any case ran on a survey mesh, `DatasetSmoke`
+    /// if every case is of a collection, `RealMeshes` if every case ran on a mesh file, else
+    /// `Procedural`.
     pub fn of(results: &[CaseResult]) -> BaselineKind {
         if results.iter().any(|r| r.mesh_source == "survey") {
             BaselineKind::Survey
+        } else if !results.is_empty() && results.iter().all(|r| r.member.is_some()) {
+            BaselineKind::DatasetSmoke
         } else if !results.is_empty() && results.iter().all(|r| r.mesh_source == "file") {
             BaselineKind::RealMeshes
         } else {
@@ -70,6 +76,7 @@ impl BaselineKind {
             BaselineKind::Survey => "survey.json",
             BaselineKind::Procedural => "procedural.json",
             BaselineKind::RealMeshes => "real-meshes.json",
+            BaselineKind::DatasetSmoke => "dataset-smoke.json",
         })
     }
 }
