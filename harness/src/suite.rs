@@ -73,6 +73,21 @@ pub struct SuiteRun {
     pub provenance: Provenance,
 }
 
+impl SuiteRun {
+    /// The run of `results` on `scenarios`, its notes gathered ([`notes_of`]).
+    fn new(
+        options: &SuiteOptions,
+        results: Vec<CaseResult>,
+        scenarios: Vec<LoadedScenario>,
+        skipped: Vec<SkippedInput>,
+        data_source: String,
+        provenance: Provenance,
+    ) -> SuiteRun {
+        let notes = notes_of(options, &scenarios, &skipped);
+        SuiteRun { results, scenarios, skipped, data_source, notes, provenance }
+    }
+}
+
 impl SuiteOptions {
     /// Take the peers' file when `peers` has one (`--peers` with its Python found); returns the note
     /// that says why peers were asked for but not run.
@@ -225,14 +240,7 @@ pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
     let results = run_plan(options, &config, &scenarios, &plan)?;
     provenance.external = crate::provenance::external_records(&results);
     let data_source = describe_data(&source, &scenarios);
-    Ok(SuiteRun {
-        notes: notes_of(options, &scenarios, &skipped),
-        results,
-        scenarios,
-        skipped,
-        data_source,
-        provenance,
-    })
+    Ok(SuiteRun::new(options, results, scenarios, skipped, data_source, provenance))
 }
 
 /// Run the scenarios of part `shard` of the suite ([`crate::shard::assign`] on their estimated cost).
@@ -258,14 +266,7 @@ pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, Harne
     let scenarios: Vec<LoadedScenario> = mine.into_iter().map(|(s, _)| s).collect();
     let results = run_plan(options, &config, &scenarios, &plan)?;
     provenance.external = crate::provenance::external_records(&results);
-    Ok(SuiteRun {
-        notes: notes_of(options, &scenarios, &skipped),
-        results,
-        scenarios,
-        skipped,
-        data_source,
-        provenance,
-    })
+    Ok(SuiteRun::new(options, results, scenarios, skipped, data_source, provenance))
 }
 
 /// The record of a run started now with `options`.
@@ -546,14 +547,7 @@ pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, Harne
     }
     results.sort_by_key(|(i, order, _)| (*i, *order));
     let results: Vec<CaseResult> = results.into_iter().map(|(_, _, c)| c).collect();
-    Ok(SuiteRun {
-        notes: notes_of(options, &scenarios, &skipped),
-        results,
-        scenarios,
-        skipped,
-        data_source,
-        provenance,
-    })
+    Ok(SuiteRun::new(options, results, scenarios, skipped, data_source, provenance))
 }
 
 /// One line on where the meshes of `scenarios` came from.

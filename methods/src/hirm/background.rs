@@ -77,6 +77,20 @@ impl KeptConstraints {
 /// Eq 22-25 on the `#V x 3` base shape `base`, synchronously.
 pub fn handle_independent_model(base: &[[f64; 3]], inputs: &SystemInputs) -> HandleIndependentModel {
     let start = Instant::now();
+    let (model, mut system) = field_gauged_system(base, inputs);
+    let plane_gauge_rhs = fix_plane_gauge(&mut system.smoothness_normal_matrix, &model);
+    HandleIndependentModel {
+        model,
+        system,
+        kept: None,
+        seconds: start.elapsed().as_secs_f64(),
+        plane_gauge_rhs,
+    }
+}
+
+/// The isoline model of the `#V x 3` base shape `base` and its system (eq 22-25) with the field
+/// gauge, before the plane gauge.
+fn field_gauged_system(base: &[[f64; 3]], inputs: &SystemInputs) -> (IsolineModel, HandleIndependentSystem) {
     let mut model = IsolineModel::new(
         inputs.frame,
         base,
@@ -88,14 +102,7 @@ pub fn handle_independent_model(base: &[[f64; 3]], inputs: &SystemInputs) -> Han
     );
     let mut system = HandleIndependentSystem::new(&mut model, inputs.laplacian.as_ref(), inputs.mu, true);
     fix_field_gauge(&mut system.smoothness_normal_matrix, inputs.fields.ncols(), inputs.isolines);
-    let plane_gauge_rhs = fix_plane_gauge(&mut system.smoothness_normal_matrix, &model);
-    HandleIndependentModel {
-        model,
-        system,
-        kept: None,
-        seconds: start.elapsed().as_secs_f64(),
-        plane_gauge_rhs,
-    }
+    (model, system)
 }
 
 /// [`handle_independent_model`] and, for `kept` (the regions of the handle set before, and `omega`),
@@ -235,17 +242,7 @@ mod tests {
     /// `T_1` of `base` with the field gauge only (what [`handle_independent_model`] builds before
     /// the plane gauge).
     fn field_gauged(base: &[[f64; 3]], inputs: &SystemInputs) -> (IsolineModel, Mat<f64>) {
-        let mut model = IsolineModel::new(
-            inputs.frame,
-            base,
-            &inputs.triangles,
-            inputs.fields.as_ref(),
-            &SetBlend::PerSet(inputs.weights.clone()),
-            inputs.isolines,
-            inputs.max_crossed_triangles,
-        );
-        let mut system = HandleIndependentSystem::new(&mut model, inputs.laplacian.as_ref(), inputs.mu, true);
-        fix_field_gauge(&mut system.smoothness_normal_matrix, inputs.fields.ncols(), inputs.isolines);
+        let (model, system) = field_gauged_system(base, inputs);
         (model, system.smoothness_normal_matrix)
     }
 
