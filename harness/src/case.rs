@@ -8,7 +8,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::config::{ConfiguredMethod, Origin};
 use crate::metrics::{
-    angle_errors, asked_turn, largest_displacement, Bends, Evaluation, Metric, Quality, RestGeometry,
+    angle_errors, asked_scale, asked_turn, largest_displacement, Bends, Evaluation, Metric, Quality,
+    RestGeometry,
 };
 use crate::scenario::LoadedScenario;
 use crate::verdict::{Motion, Status, Unfinished, VerdictRules};
@@ -523,6 +524,7 @@ pub fn run_case(
             largest_handle_move: result.largest_handle_move_over_diag,
             asked_turn_deg: asked_turn(scenario.mesh.positions(), &step.handles, &targets, Bends::FromHeld)
                 .to_degrees(),
+            asked_scale: asked_scale(scenario.mesh.positions(), &step.handles, &targets),
             reference_finished,
         };
         let reasons = rules.reasons(&result.quality, motion);

@@ -23,6 +23,7 @@ pub enum Metric {
     EPhi,
     EArea,
     ELength,
+    AreaChange,
     VolumeChange,
     Folds,
     TurnBeyondHandles,
@@ -169,7 +170,7 @@ pub struct MetricSpec {
 }
 
 /// The metric table, in [`Metric`] order.
-pub const METRICS: [MetricSpec; 11] = [
+pub const METRICS: [MetricSpec; 12] = [
     MetricSpec {
         metric: Metric::ETheta,
         key: "e_theta_deg",
@@ -218,6 +219,19 @@ pub const METRICS: [MetricSpec; 11] = [
         plotted: true,
         format: Format::Fixed(4),
         compute: |e| Some(length_distortion(e.rest, e.topology, e.result)),
+    },
+    MetricSpec {
+        metric: Metric::AreaChange,
+        key: "area_change",
+        label: "ΔA/A⁰",
+        unit: "",
+        doc: "(A − A⁰) / A⁰ of the total surface area; s² − 1 for a uniform scaling by s (e_area is an RMS \
+              over faces and does not tell a swollen result from one stretched here and squeezed there)",
+        better: Better::NearZero,
+        gate: Some(Tolerance { relative: 0.02, absolute: 0.001 }),
+        plotted: false,
+        format: Format::Signed(3),
+        compute: |e| Some(area_change(e.rest, e.mesh, e.result)),
     },
     MetricSpec {
         metric: Metric::VolumeChange,
@@ -317,11 +331,12 @@ pub const METRICS: [MetricSpec; 11] = [
 
 impl Metric {
     /// Every metric, in table order.
-    pub const ALL: [Metric; 11] = [
+    pub const ALL: [Metric; 12] = [
         Metric::ETheta,
         Metric::EPhi,
         Metric::EArea,
         Metric::ELength,
+        Metric::AreaChange,
         Metric::VolumeChange,
         Metric::Folds,
         Metric::TurnBeyondHandles,
@@ -489,6 +504,13 @@ pub fn area_distortion(rest: &RestGeometry, mesh: &TriMesh, result: &[[f64; 3]])
 pub fn length_distortion(rest: &RestGeometry, topology: &Topology, result: &[[f64; 3]]) -> f64 {
     let lengths = edge_lengths(result, topology.edges());
     rms(rest.lengths.iter().zip(&lengths).filter(|(l0, _)| **l0 > 0.0).map(|(l0, l)| (l / l0).ln()))
+}
+
+/// `(A - A⁰) / A⁰` of the total surface area of the `#V x 3` `result` against the rest mesh.
+pub fn area_change(rest: &RestGeometry, mesh: &TriMesh, result: &[[f64; 3]]) -> f64 {
+    let a0: f64 = rest.areas.iter().sum();
+    let a: f64 = face_areas(result, mesh.triangles()).iter().sum();
+    (a - a0) / a0
 }
 
 /// `(V - V⁰) / V⁰` of the signed enclosed volume; `None` for an open mesh or a rest volume that is
@@ -676,6 +698,31 @@ pub fn asked_turn(rest: &[[f64; 3]], handles: &HandleSet, targets: &HandleTarget
     rotation + bend
 }
 
+/// The scale the handles ask: the RMS distance of the constrained vertices' targets from their
+/// centroid over that of their rest positions (`rest`: `#V x 3`). 1 for any rigid motion of all
+/// handles together and for regions each turned about its own centroid (the dataset's bend and
+/// twist); above 1 where regions are pulled apart (a stretch), below where they are pushed together.
+/// 1 when the handles have no spread (fewer than two distinct constrained vertices).
+pub fn asked_scale(rest: &[[f64; 3]], handles: &HandleSet, targets: &HandleTargets) -> f64 {
+    let pairs: Vec<([f64; 3], [f64; 3])> =
+        handles.constrained().zip(targets.positions()).map(|(v, t)| (rest[v as usize], *t)).collect();
+    let n = pairs.len() as f64;
+    let (mut c0, mut c1) = ([0.0; 3], [0.0; 3]);
+    for (p, t) in &pairs {
+        for a in 0..3 {
+            c0[a] += p[a] / n;
+            c1[a] += t[a] / n;
+        }
+    }
+    let spread0: f64 = pairs.iter().map(|(p, _)| norm(sub(*p, c0)).powi(2)).sum();
+    let spread1: f64 = pairs.iter().map(|(_, t)| norm(sub(*t, c1)).powi(2)).sum();
+    if spread0 > 0.0 && spread1.is_finite() {
+        (spread1 / spread0).sqrt()
+    } else {
+        1.0
+    }
+}
+
 /// Per vertex, the angle (radians) of the rotation closest to
 /// `sum_j (x_i - x_j)(x0_i - x0_j)^T` over its one-ring: how far its neighbourhood turned from
 /// `rest` to `result` (both `#V x 3`). An isolated vertex turns 0.
@@ -850,6 +897,51 @@ mod tests {
         assert!(asked < 5.0, "{asked}");
     }
 
+    /// The bar's two end regions: 1 when the top turns about its own centroid (a bend or twist
+    /// asks no size), `s` when every target is scaled by `s`, and above 1 when the ends move apart.
+    #[test]
+    fn the_asked_scale_is_the_spread_of_the_targets() {
+        let (mesh, _, _) = shape(ShapeKind::Bar);
+        let p = mesh.positions();
+        let (lo, hi) = mesh.bbox();
+        let height = hi[2] - lo[2];
+        let region = |name: &str, keep: &dyn Fn(f64) -> bool| methods::HandleRegion {
+            name: name.into(),
+            vertices: (0..p.len() as u32).filter(|&v| keep(p[v as usize][2])).collect(),
+        };
+        let handles = HandleSet::new(
+            vec![
+                region("bottom", &|z| z < lo[2] + 0.1 * height),
+                region("top", &|z| z > lo[2] + 0.9 * height),
+            ],
+            p.len(),
+        )
+        .unwrap();
+        let top = handles.region_of();
+        let scale_of = |f: &dyn Fn([f64; 3], bool) -> [f64; 3]| {
+            let targets = HandleTargets::new(
+                &handles,
+                handles.constrained().map(|v| f(p[v as usize], top[v as usize] == 1)).collect(),
+            )
+            .unwrap();
+            asked_scale(p, &handles, &targets)
+        };
+        let n = handles.regions()[1].vertices.len() as f64;
+        let mut c = [0.0; 3];
+        for &v in &handles.regions()[1].vertices {
+            for a in 0..3 {
+                c[a] += p[v as usize][a] / n;
+            }
+        }
+        let twist = AffineTransform::rotation_about([0.0, 0.0, 1.0], 1.2, c);
+        let turned = scale_of(&|x, is_top| if is_top { twist.apply(x) } else { x });
+        assert!((turned - 1.0).abs() < 1e-12, "{turned}");
+        let scaled = scale_of(&|x, _| [1.3 * x[0] + 2.0, 1.3 * x[1], 1.3 * x[2]]);
+        assert!((scaled - 1.3).abs() < 1e-12, "{scaled}");
+        let stretched = scale_of(&|x, is_top| if is_top { [x[0], x[1], x[2] + 0.25 * height] } else { x });
+        assert!(stretched > 1.15 && stretched < 1.3, "{stretched}");
+    }
+
     /// Against a reference: 0 for the reference itself and for both turned by one rigid motion; a
     /// part turned on its own shows its turn once it holds more than half of the free surface.
     #[test]
@@ -950,6 +1042,7 @@ mod tests {
                 close(Metric::Folds, 0.0);
                 close(Metric::EArea, (2.0 * s.ln()).abs());
                 close(Metric::ELength, s.ln().abs());
+                close(Metric::AreaChange, s * s - 1.0);
                 // Only closed look-alikes have a volume.
                 let (_, topology, _) = shape(kind);
                 if topology.is_closed() {

@@ -33,6 +33,9 @@ pub struct VerdictRules {
     pub max_turn_to_arap_of_asked: f64,
     /// ... but never below this many degrees.
     pub min_turn_to_arap_allowed_deg: f64,
+    /// How far the total surface area may leave the range the handles ask (`Motion::asked_scale`
+    /// squared, and no change), as a fraction: `swells` above, `shrinks` below.
+    pub max_area_change_beyond_asked: f64,
 }
 
 /// What a verdict reads of a case besides its measures.
@@ -46,6 +49,9 @@ pub struct Motion {
     /// The turn the last step's handles ask of the free surface (degrees,
     /// [`crate::metrics::asked_turn`] with bends from the held regions only).
     pub asked_turn_deg: f64,
+    /// The scale the last step's handles ask ([`crate::metrics::asked_scale`]): 1 for rigid handle
+    /// motions, above 1 where they pull regions apart.
+    pub asked_scale: f64,
     /// The scenario's reference (`arap`) finished (ok or suspect), so its result judges this one's
     /// turns (`turn_to_arap_deg`); an unfinished reference is an iterate, and then only the result's
     /// own measures judge it (`turn_beyond_handles_deg` among them).
@@ -66,6 +72,7 @@ impl VerdictRules {
             ("max_turn_beyond_handles_deg", rules.max_turn_beyond_handles_deg),
             ("max_turn_to_arap_of_asked", rules.max_turn_to_arap_of_asked),
             ("min_turn_to_arap_allowed_deg", rules.min_turn_to_arap_allowed_deg),
+            ("max_area_change_beyond_asked", rules.max_area_change_beyond_asked),
         ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(config(format!("`{name}` must be a finite number >= 0, not {value}")));
@@ -77,7 +84,8 @@ impl VerdictRules {
     /// The reasons a finished case with `quality` and `motion` is suspect (empty: `ok`). A result is
     /// judged on itself, and against the reference's result only where that finished.
     pub fn reasons(&self, quality: &Quality, motion: Motion) -> Vec<String> {
-        let Motion { largest_move, largest_handle_move, asked_turn_deg, reference_finished } = motion;
+        let Motion { largest_move, largest_handle_move, asked_turn_deg, asked_scale, reference_finished } =
+            motion;
         let mut reasons = Vec::new();
         let non_finite: Vec<&str> = quality.non_finite().map(Metric::key).collect();
         if !non_finite.is_empty() || !largest_move.is_finite() {
@@ -115,6 +123,30 @@ impl VerdictRules {
                  (> {allowed:.0}°, {:.1} of the {asked_turn_deg:.0}° the handles ask)",
                 self.max_turn_to_arap_of_asked
             ));
+        }
+        if let Some(change) = quality.get(Metric::AreaChange).filter(|c| c.is_finite()) {
+            // Judged on ln(A / A⁰) against [2 ln min(s, 1), 2 ln max(s, 1)]: a method may keep the area
+            // or scale it as the handles do, and no further.
+            let (ratio, margin) = (1.0 + change, (1.0 + self.max_area_change_beyond_asked).ln());
+            let (low, high) = (asked_scale.min(1.0).powi(2), asked_scale.max(1.0).powi(2));
+            let percent = |r: f64| 100.0 * (r - 1.0);
+            if ratio > 0.0 && ratio.ln() - high.ln() > margin {
+                reasons.push(format!(
+                    "swells: its surface area grew {:+.0}% where the handles ask at most {:+.0}% \
+                     (> {:.0}% beyond)",
+                    percent(ratio),
+                    percent(high),
+                    100.0 * self.max_area_change_beyond_asked
+                ));
+            } else if ratio <= 0.0 || low.ln() - ratio.ln() > margin {
+                reasons.push(format!(
+                    "shrinks: its surface area fell {:+.0}% where the handles ask at least {:+.0}% \
+                     (> {:.0}% beyond)",
+                    percent(ratio),
+                    percent(low),
+                    100.0 * self.max_area_change_beyond_asked
+                ));
+            }
         }
         let allowed = largest_handle_move + self.frame_margin_diagonals;
         if largest_move > allowed {
@@ -310,13 +342,20 @@ mod tests {
             max_turn_beyond_handles_deg: 45.0,
             max_turn_to_arap_of_asked: 0.4,
             min_turn_to_arap_allowed_deg: 5.0,
+            max_area_change_beyond_asked: 0.25,
         }
     }
 
     /// A case that moved `largest_move` diagonals with handles moved 0.2, asked 50 deg, judged
     /// against a finished reference.
     fn moved(largest_move: f64) -> Motion {
-        Motion { largest_move, largest_handle_move: 0.2, asked_turn_deg: 50.0, reference_finished: true }
+        Motion {
+            largest_move,
+            largest_handle_move: 0.2,
+            asked_turn_deg: 50.0,
+            asked_scale: 1.0,
+            reference_finished: true,
+        }
     }
 
     fn quality(folds: f64, residual: f64) -> Quality {
@@ -360,6 +399,32 @@ mod tests {
         assert!(r.reasons(&against, still).is_empty(), "the 5 deg floor");
         against.set(Metric::TurnToArap, Some(6.0));
         assert_eq!(r.reasons(&against, still).len(), 1);
+        // The area: +25% beyond what the handles ask is still ok, more swells; a stretch by 1.2
+        // asks +44%; shrinking is judged the same way below.
+        let mut area = quality(0.0, 0.0);
+        area.set(Metric::AreaChange, Some(0.24));
+        assert!(r.reasons(&area, moved(0.3)).is_empty());
+        area.set(Metric::AreaChange, Some(0.26));
+        let reasons = r.reasons(&area, moved(0.3));
+        assert!(
+            reasons.len() == 1 && reasons[0].starts_with("swells: its surface area grew +26%"),
+            "{reasons:?}"
+        );
+        let stretched = Motion { asked_scale: 1.2, ..moved(0.3) };
+        area.set(Metric::AreaChange, Some(0.7));
+        assert!(r.reasons(&area, stretched).is_empty(), "1.44 x 1.25 = 1.8");
+        area.set(Metric::AreaChange, Some(0.85));
+        assert_eq!(r.reasons(&area, stretched).len(), 1);
+        area.set(Metric::AreaChange, Some(-0.19));
+        assert!(r.reasons(&area, moved(0.3)).is_empty(), "1 / 1.25 = 0.8");
+        area.set(Metric::AreaChange, Some(-0.21));
+        let reasons = r.reasons(&area, moved(0.3));
+        assert!(
+            reasons.len() == 1 && reasons[0].starts_with("shrinks: its surface area fell -21%"),
+            "{reasons:?}"
+        );
+        area.set(Metric::AreaChange, Some(-1.0));
+        assert_eq!(r.reasons(&area, moved(0.3)).len(), 1, "collapsed to nothing");
         let mut q = quality(0.0, 0.0);
         q.set(Metric::EArea, Some(f64::INFINITY));
         let nan = r.reasons(&q, moved(f64::NAN));
@@ -424,7 +489,8 @@ mod tests {
         std::fs::write(
             &path,
             "max_folds = -1\nmax_handle_residual_over_diag = 1e-3\nframe_margin_diagonals = 1\n\
-             max_turn_beyond_handles_deg = 45\nmax_turn_to_arap_of_asked = 0.4\nmin_turn_to_arap_allowed_deg = 5\n",
+             max_turn_beyond_handles_deg = 45\nmax_turn_to_arap_of_asked = 0.4\nmin_turn_to_arap_allowed_deg = 5\n\
+             max_area_change_beyond_asked = 0.25\n",
         )
         .unwrap();
         let e = VerdictRules::load(&path).unwrap_err().to_string();
