@@ -66,7 +66,15 @@ pub fn render_index(
         "tr.suspect td:nth-child(-n+2){background:#fff1d6}tr.failed td:nth-child(-n+2){background:#fdd}\n",
         "tr.unfinished td:nth-child(-n+2){background:#e4e8ff}\n",
         "tr.viewable{cursor:pointer}tr.viewable:hover td{outline:1px solid #99c}\n",
-        "#viewer canvas{border:1px solid #ccc;margin-right:8px;max-width:48%}\n",
+        "#viewer .viewer-pane{position:relative;display:inline-block;max-width:48%;margin-right:8px;\
+         vertical-align:top}\n",
+        "#viewer canvas{display:block;max-width:100%;border:1px solid #ccc;cursor:crosshair}\n",
+        "#viewer .viewer-name{position:absolute;left:9px;top:5px;font:14px sans-serif;color:#222;\
+         pointer-events:none}\n",
+        "#viewer .viewer-pick{position:absolute;margin:6px 0 0 6px;padding:1px 4px;font:12px sans-serif;\
+         white-space:nowrap;background:#fffe;border:1px solid #444;pointer-events:none}\n",
+        "#viewer .viewer-pick::before{content:'';position:absolute;left:-11px;top:-11px;width:7px;height:7px;\
+         border-radius:50%;background:#000;border:1px solid #fff}\n",
         "th.sortable{cursor:pointer}th.sorted-up::after{content:' ▲'}th.sorted-down::after{content:' ▼'}\n",
         "#filters label{margin-right:1em;font-size:14px}#row-count{font-size:13px;color:#555}\n",
         "div.ranking-grid{display:flex;flex-wrap:wrap;gap:1em;align-items:flex-start}table.ranking{margin:0}\n",
@@ -226,8 +234,12 @@ pub fn render_index(
         "<option value=\"angle\">angle error, 0&ndash;10&deg;</option>",
         "<option value=\"area\">area distortion, &times;0.5 blue to &times;2 red</option></select> ",
         "left <select id=\"viewer-left\"></select> <button id=\"viewer-close\">close</button></p>",
-        "<canvas id=\"viewer-left-canvas\" width=\"640\" height=\"520\"></canvas>",
-        "<canvas id=\"viewer-right-canvas\" width=\"640\" height=\"520\"></canvas></div>\n"
+        "<span class=\"viewer-pane\"><canvas id=\"viewer-left-canvas\" width=\"640\" height=\"520\"></canvas>",
+        "<span class=\"viewer-name\" id=\"viewer-left-name\"></span>",
+        "<span class=\"viewer-pick\" id=\"viewer-left-pick\" hidden></span></span>",
+        "<span class=\"viewer-pane\"><canvas id=\"viewer-right-canvas\" width=\"640\" height=\"520\"></canvas>",
+        "<span class=\"viewer-name\" id=\"viewer-right-name\"></span>",
+        "<span class=\"viewer-pick\" id=\"viewer-right-pick\" hidden></span></span></div>\n"
     ));
     page.push_str("<h2 id=\"measures\">What the columns mean</h2>\n<p>Every measure compares the result with the rest mesh:</p>\n");
     page.push_str("<dl class=\"metrics\">\n");
