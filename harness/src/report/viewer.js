@@ -559,10 +559,11 @@
     box.dataset.centre = Array.prototype.slice.call(images[0], centre, centre + 3).join(',');
   }
 
-  // One redraw per animation frame however many events ask for one.
+  // One redraw for the events that came while the last one drew, however many: the redraw runs
+  // as the next task (not at an animation frame, which headless Chromium does not always give).
   var nextFrame = null;
   function onNextFrame(f) {
-    if (!nextFrame) requestAnimationFrame(function () { var g = nextFrame; nextFrame = null; g(); });
+    if (!nextFrame) setTimeout(function () { var g = nextFrame; nextFrame = null; g(); }, 0);
     nextFrame = f;
   }
 
@@ -667,6 +668,7 @@
           var rest = restMesh(restName);
           var views = [left ? viewOf(left.dataset.view, left.dataset.method, false) : viewOf(restName, 'rest', true),
             viewOf(row.dataset.view, row.dataset.method, false)];
+          delete box.dataset.picked;
           shown = { rest: rest, views: views, reach: reachOf(rest.center, views.map(function (v) { return v.positions; })),
             colouredBy: null, picked: null };
           renderers.forEach(function (r, k) { r.setMesh(views[k], rest.triangles); });
