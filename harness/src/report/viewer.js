@@ -361,7 +361,8 @@
     if (!gl.getProgramParameter(program, gl.LINK_STATUS) && !gl.isContextLost()) {
       throw new Error('viewer program: ' + gl.getProgramInfoLog(program));
     }
-    return { program: program, camera: gl.getUniformLocation(program, 'camera'), toClip: gl.getUniformLocation(program, 'toClip') };
+    return { program: program, camera: gl.getUniformLocation(program, 'camera'),
+      toClip: gl.getUniformLocation(program, 'toClip') };
   }
 
   // Flat shading gives each face its own colour, so a corner shared by faces of different colours
@@ -612,8 +613,8 @@
   // What the label says of vertex v in a view: its role, or the error of the faces around it
   // (the mean of their angle errors, or their area over their rest area).
   function vertexNote(view, v) {
-    var rest = shown.rest, mode = colourBy.value, role = ['free', 'fixed', 'handle'][rest.roles[v]] || 'role ' + rest.roles[v];
-    if (mode === 'shaded' || view.isRest) return 'vertex ' + v + ': ' + role;
+    var rest = shown.rest, mode = colourBy.value, role = ['free', 'fixed', 'handle'][rest.roles[v]];
+    if (mode === 'shaded' || view.isRest) return 'vertex ' + v + ': ' + (role || 'role ' + rest.roles[v]);
     if (!view.errors) view.errors = faceErrors(view.positions);
     var faces = facesAround(rest.triangles, v), before = restGeometry(rest).areas, sum = 0, area = 0, area0 = 0;
     faces.forEach(function (f) { sum += view.errors.angle[f]; area += view.errors.areas[f]; area0 += before[f]; });
@@ -644,6 +645,21 @@
 
   // ---- Opening a case.
 
+  // Show `views` (left, right) of meshes on `rest`'s triangles: the renderers (made the first
+  // time) get their meshes, the panes their names; the picked vertex is forgotten.
+  function present(rest, views) {
+    if (!renderers) {
+      renderers = makeRenderers(params.get('renderer') !== 'canvas');
+      box.dataset.renderer = renderers[0].kind;
+    }
+    shown = { rest: rest, views: views, reach: reachOf(rest.center, views.map(function (v) { return v.positions; })),
+      colouredBy: null, picked: null };
+    renderers.forEach(function (r, k) { r.setMesh(views[k], rest.triangles); });
+    views.forEach(function (v, k) { if (names[k]) names[k].textContent = v.method; });
+    delete box.dataset.picked;
+    notePicks();
+  }
+
   // Open the view of the row `row` (a results-table row with data-view); `then` runs after its
   // first picture.
   function open(row, leftMethod, then) {
@@ -661,22 +677,12 @@
     load(restName, function () {
       load(row.dataset.view, function () {
         var finish = function () {
-          if (!renderers) {
-            renderers = makeRenderers(params.get('renderer') !== 'canvas');
-            box.dataset.renderer = renderers[0].kind;
-          }
           var rest = restMesh(restName);
-          var views = [left ? viewOf(left.dataset.view, left.dataset.method, false) : viewOf(restName, 'rest', true),
-            viewOf(row.dataset.view, row.dataset.method, false)];
-          delete box.dataset.picked;
-          shown = { rest: rest, views: views, reach: reachOf(rest.center, views.map(function (v) { return v.positions; })),
-            colouredBy: null, picked: null };
-          renderers.forEach(function (r, k) { r.setMesh(views[k], rest.triangles); });
+          present(rest, [left ? viewOf(left.dataset.view, left.dataset.method, false) : viewOf(restName, 'rest', true),
+            viewOf(row.dataset.view, row.dataset.method, false)]);
           if (box.dataset.rest !== restName) camera = { yaw: 0.6, pitch: rest.pitch, zoom: 1 };
           box.dataset.rest = restName;
           title.textContent = scenario + ': ' + row.dataset.method;
-          views.forEach(function (v, k) { if (names[k]) names[k].textContent = v.method; });
-          notePicks();
           redraw();
           box.dataset.loadMs = Math.round(performance.now() - started);
           describe();
@@ -690,7 +696,6 @@
   }
 
   // ---- Controls.
-
 
   document.querySelectorAll('#results-table tbody tr[data-view]').forEach(function (row) {
     row.classList.add('viewable');
