@@ -1114,6 +1114,82 @@ fn unreferenced_vertices_are_dropped_and_results_keep_the_input_order() {
     assert!(page.contains("1 unreferenced vertices dropped"), "the note is on the page");
 }
 
+/// `refine`: each level makes four faces of one, and a slab picks the same old vertices on the
+/// refined mesh (midpoint keeps the file's shape and box) with new ones between them; Loop keeps the
+/// boundary loops and the Euler characteristic (a closed mesh stays closed and of its genus; the
+/// meshes crate tests that on closed shapes too). Regions by vertex id and procedural
+/// shapes are refused, naming the key.
+#[test]
+fn a_refined_mesh_file_keeps_its_regions_and_topology() {
+    use harness::scenario::{load_spec, DataSource};
+    let root = tempfile::tempdir().unwrap();
+    let bar = generate(ShapeKind::Bar, 600).unwrap().mesh;
+    let path = root.path().join("bar.off");
+    meshes::io::write_off(&path, &bar).unwrap();
+    let load = |refine: u32, scheme: &str| {
+        let file = root.path().join(format!("bar-{refine}-{scheme}.toml"));
+        let text = format!(
+            "name = \"bar\"\nmesh = \"{}\"\nrefine = {refine}\nrefine_scheme = \"{scheme}\"\n{FIXED_AND_HANDLE}",
+            path.display()
+        );
+        std::fs::write(&file, text).unwrap();
+        let mut loaded = load_spec(&file).unwrap().load(&DataSource::Procedural).unwrap();
+        loaded.scenarios.remove(0)
+    };
+    let euler = |s: &harness::scenario::LoadedScenario| {
+        s.mesh.n_vertices() as i64 - s.topology.edges().len() as i64 + s.mesh.n_faces() as i64
+    };
+    let plain = load(0, "midpoint");
+    let regions = |s: &harness::scenario::LoadedScenario| -> Vec<Vec<u32>> {
+        s.steps[0].handles.regions().iter().map(|r| r.vertices.clone()).collect()
+    };
+    for levels in 1..=2u32 {
+        let fine = load(levels, "midpoint");
+        assert_eq!(fine.mesh.n_faces(), bar.n_faces() * 4usize.pow(levels));
+        assert_eq!(euler(&fine), euler(&plain));
+        for (old, new) in regions(&plain).iter().zip(regions(&fine)) {
+            let kept: Vec<u32> = new.iter().copied().filter(|&v| (v as usize) < bar.n_vertices()).collect();
+            assert_eq!(&kept, old, "the same old vertices");
+            assert!(
+                new.len() > 2 * old.len(),
+                "and the new ones between them: {} of {}",
+                new.len(),
+                old.len()
+            );
+        }
+        assert!(
+            fine.notes.iter().any(|n| n.contains("refined by") && n.contains("midpoint")),
+            "{:?}",
+            fine.notes
+        );
+    }
+    let smooth = load(1, "loop");
+    assert_eq!(smooth.topology.is_closed(), plain.topology.is_closed());
+    assert_eq!(smooth.topology.boundary_loops().len(), plain.topology.boundary_loops().len());
+    assert_eq!(euler(&smooth), euler(&plain), "the same genus");
+    for (old, new) in regions(&plain).iter().zip(regions(&smooth)) {
+        let kept = new.iter().filter(|&&v| (v as usize) < bar.n_vertices() && old.contains(&v)).count();
+        assert!(
+            kept as f64 >= 0.9 * old.len() as f64,
+            "Loop moves the surface little: {kept} of {}",
+            old.len()
+        );
+    }
+    let refused = |text: String| {
+        let file = root.path().join("refused.toml");
+        std::fs::write(&file, text).unwrap();
+        load_spec(&file).unwrap_err().to_string()
+    };
+    let e = refused("name = \"p\"\nprocedural = { shape = \"bar\" }\nrefine = 1\n".into());
+    assert!(e.contains("refine") && e.contains("refused.toml"), "{e}");
+    let e = refused(format!(
+        "name = \"ids\"\nmesh = \"{}\"\nrefine = 1\n[[regions]]\nname = \"few\"\nrole = \"fixed\"\n\
+         select = {{ vertices = [0, 1, 2] }}\n",
+        path.display()
+    ));
+    assert!(e.contains("region `few`") && e.contains("bounding-box coordinates"), "{e}");
+}
+
 /// The real-mesh suite (`configs/real-meshes`): four meshes of `../shared/real-meshes` in OFF and
 /// OBJ and an open terrain of its dataset, edited by scenarios written only in TOML (the knight and
 /// the head bust with libigl's own `.dmat` selections, the bunny, the 43K armadillo and the terrain

@@ -15,6 +15,7 @@
 //! - [`clean`]: unreferenced vertices, duplicates, components (error, mesh).
 //! - [`repair`]: opt-in repair of zero-area and repeated faces, non-manifold edges and orientation
 //!   (error, mesh, primitives).
+//! - [`subdivision`]: refinement by Loop or midpoint subdivision (error, mesh, topology).
 //! - [`shapes`]: procedural look-alikes of the survey shapes (error, vector, mesh, edit).
 //! - [`io`]: mesh and edit file formats (error, mesh, geometry, edit).
 
@@ -27,6 +28,7 @@ pub mod mesh;
 mod primitives;
 pub mod repair;
 pub mod shapes;
+pub mod subdivision;
 pub mod topology;
 pub mod vector;
 

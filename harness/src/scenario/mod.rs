@@ -104,6 +104,16 @@ pub struct ScenarioSpec {
     /// refused (a collection skips them).
     #[serde(default)]
     pub repair: bool,
+    /// Subdivide each mesh file this many times once it is loaded (and repaired), before anything
+    /// else ([`meshes::subdivision`]: each level makes four faces of one), so a real shape runs at
+    /// any size. Regions must then be in bounding-box coordinates (`box`, `sphere`, `slab`): vertex
+    /// ids of the file would name only its old vertices. Default 0.
+    #[serde(default)]
+    pub refine: u32,
+    /// How [`ScenarioSpec::refine`] places vertices: `"loop"` (default: a smooth surface, like a
+    /// finer scan of the object) or `"midpoint"` (the file's exact shape, sampled finer).
+    #[serde(default)]
+    pub refine_scheme: RefineScheme,
     /// The regions of the first edit (default for `survey`/`procedural`: the survey selection).
     #[serde(default)]
     pub regions: Vec<RegionSpec>,
@@ -123,6 +133,24 @@ pub struct ScenarioSpec {
     /// Every file the scenario named and loading read (meshes, selections, transforms).
     #[serde(skip)]
     pub files_read: FilesRead,
+}
+
+/// The subdivision scheme of `refine_scheme` ([`meshes::subdivision::Scheme`]).
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum RefineScheme {
+    #[default]
+    Loop,
+    Midpoint,
+}
+
+impl RefineScheme {
+    fn scheme(self) -> meshes::subdivision::Scheme {
+        match self {
+            RefineScheme::Loop => meshes::subdivision::Scheme::Loop,
+            RefineScheme::Midpoint => meshes::subdivision::Scheme::Midpoint,
+        }
+    }
 }
 
 /// A region as written: its vertices and, for a handle, its transform (see [`motion`]). The
@@ -406,6 +434,25 @@ pub fn load_spec(path: &Path) -> Result<ScenarioSpec, HarnessError> {
     if let Some(p) = &spec.procedural {
         p.shape.parse::<ShapeKind>().map_err(|e| config(format!("procedural.shape: {e}")))?;
     }
+    if spec.refine > 0 {
+        if builtin {
+            return Err(config(
+                "`refine` applies to mesh files (`mesh`, `meshes`, `[manifest]`); a procedural shape \
+                 takes its size from `vertices`"
+                    .into(),
+            ));
+        }
+        let by_ids = spec.regions.iter().find(|r| {
+            !matches!(r.select, Selection::Box { .. } | Selection::Sphere { .. } | Selection::Slab { .. })
+        });
+        if let Some(region) = by_ids {
+            return Err(config(format!(
+                "region `{}`: `refine` needs regions in bounding-box coordinates (box, sphere, slab); \
+                 vertex ids of the file would name only its old vertices",
+                region.name
+            )));
+        }
+    }
     // The names in `methods` are checked against the run's methods (configs/methods.toml and any
     // peers) when the run is prepared.
     Ok(spec)
@@ -635,6 +682,9 @@ impl ScenarioSpec {
             }
             input = repaired;
         }
+        if self.refine > 0 {
+            input = self.refined(input, path, &mut notes)?;
+        }
         let (mesh, map) = meshes::clean::drop_unreferenced(&input);
         let dropped = map.dropped();
         if !dropped.is_empty() {
@@ -683,6 +733,28 @@ impl ScenarioSpec {
             notes,
             member,
         })
+    }
+
+    /// `input` (read from `path`) subdivided [`ScenarioSpec::refine`] times, with a note of the
+    /// counts. Its vertices keep their indices and the new ones follow, so the refined mesh is the
+    /// input from here on (results are written on it).
+    fn refined(&self, input: TriMesh, path: &Path, notes: &mut Vec<String>) -> Result<TriMesh, HarnessError> {
+        let refined = meshes::subdivision::refine(&input, self.refine, self.refine_scheme.scheme())
+            .map_err(|e| e.in_file(path))?;
+        notes.push(format!(
+            "{}: refined by {} level(s) of {} subdivision: {} -> {} vertices, {} -> {} faces",
+            path.display(),
+            self.refine,
+            match self.refine_scheme {
+                RefineScheme::Loop => "Loop",
+                RefineScheme::Midpoint => "midpoint",
+            },
+            input.n_vertices(),
+            refined.n_vertices(),
+            input.n_faces(),
+            refined.n_faces()
+        ));
+        Ok(refined)
     }
 
     /// The steps `build` makes from `mesh` posed in the scenario's [`Frame`], their motions taken
