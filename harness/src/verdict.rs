@@ -16,6 +16,24 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use crate::error::HarnessError;
 use crate::metrics::{Metric, Quality};
 
+/// The kinds of shape reasons [`VerdictRules::reasons`] gives, each the start of its text (the
+/// dataset report counts cases per kind).
+pub const REASON_KINDS: [&str; 8] = [
+    "non-finite",
+    "folds",
+    "misses its handles",
+    "turns a free region",
+    "turned against arap",
+    "swells",
+    "shrinks",
+    "leaves its frame",
+];
+
+/// The kind of a shape reason ([`REASON_KINDS`]), if it is one of them.
+pub fn reason_kind(reason: &str) -> Option<&'static str> {
+    REASON_KINDS.into_iter().find(|k| reason.starts_with(k))
+}
+
 /// When a finished case is suspect (`configs/verdicts.toml`).
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -429,6 +447,24 @@ mod tests {
         q.set(Metric::EArea, Some(f64::INFINITY));
         let nan = r.reasons(&q, moved(f64::NAN));
         assert_eq!(nan, vec!["non-finite e_area, positions".to_string()]);
+        assert_eq!(reason_kind(&nan[0]), Some("non-finite"));
+        // Every reason above has its kind; all of them at once, each once.
+        let mut all = quality(1e-4, 2e-3);
+        all.set(Metric::TurnBeyondHandles, Some(61.0));
+        all.set(Metric::TurnToArap, Some(21.0));
+        all.set(Metric::AreaChange, Some(0.5));
+        let kinds: Vec<&str> = r.reasons(&all, moved(1.5)).iter().filter_map(|r| reason_kind(r)).collect();
+        assert_eq!(
+            kinds,
+            [
+                "folds",
+                "misses its handles",
+                "turns a free region",
+                "turned against arap",
+                "swells",
+                "leaves its frame"
+            ]
+        );
     }
 
     #[test]

@@ -18,7 +18,7 @@ use crate::case::CaseResult;
 use crate::metrics::{percentile, Metric};
 use crate::pareto::TimeAxis;
 use crate::scenario::SkippedInput;
-use crate::verdict::STATUS_KINDS;
+use crate::verdict::{reason_kind, REASON_KINDS, STATUS_KINDS};
 
 /// The measures whose spread the report gives, lower is better for each.
 pub const SPREAD_MEASURES: [Metric; 4] = [Metric::ETheta, Metric::EPhi, Metric::EArea, Metric::RmsToArap];
@@ -213,6 +213,8 @@ pub fn render_markdown(results: &[CaseResult], skipped: &[SkippedInput]) -> Stri
     }
     let _ = writeln!(md, " {} |\n", skipped.len());
 
+    md.push_str(&reasons_table(&cases, &methods));
+
     let ranks = ranks(&cases);
     md.push_str(
         "## Error spread, cost and rank\n\nMedian and 90th percentile over the cases with a finished shape \
@@ -317,6 +319,34 @@ pub fn render_markdown(results: &[CaseResult], skipped: &[SkippedInput]) -> Stri
     md
 }
 
+/// Per method, how many cases (all families) carry each kind of shape reason
+/// ([`crate::verdict::REASON_KINDS`]; a case may have several): what makes the suspect cases suspect.
+fn reasons_table(cases: &[&CaseResult], methods: &[&str]) -> String {
+    let mut md = String::from(
+        "## Why suspect\n\nCases of all families whose shape a verdict flags, per reason (a case may have \
+         several; unfinished cases count too, their shape reasons follow the cap).\n\n| method |",
+    );
+    for kind in REASON_KINDS {
+        let _ = write!(md, " {kind} |");
+    }
+    md.push('\n');
+    md.push_str(&"|---".repeat(REASON_KINDS.len() + 1));
+    md.push_str("|\n");
+    for m in methods {
+        let _ = write!(md, "| {m} |");
+        for kind in REASON_KINDS {
+            let n = cases
+                .iter()
+                .filter(|c| c.method == *m && c.status.shape_reasons().any(|r| reason_kind(r) == Some(kind)))
+                .count();
+            let _ = write!(md, " {n} |");
+        }
+        md.push('\n');
+    }
+    md.push('\n');
+    md
+}
+
 /// Write `dataset.md` (`markdown`, from [`render_markdown`]) under `dir`, atomically.
 pub fn write_markdown(dir: &std::path::Path, markdown: &str) -> Result<(), crate::error::HarnessError> {
     meshes::io::atomic_write(dir.join("dataset.md"), |w| {
@@ -395,6 +425,22 @@ mod tests {
         let cases = [
             case("bend", "a", "arap", 10, 1.0, Status::Ok),
             case("bend", "b", "arap", 10, 1.0, Status::Failed("x".into())),
+            case(
+                "bend",
+                "a",
+                "hirm",
+                10,
+                1.0,
+                Status::Suspect(vec!["swells: +40%".into(), "folds: 1%".into()]),
+            ),
+            case(
+                "bend",
+                "b",
+                "hirm",
+                10,
+                1.0,
+                Status::Unfinished(vec!["stopped at the cap".into(), "swells: +30%".into()]),
+            ),
         ];
         let skipped = [SkippedInput {
             scenario: "bend-c".into(),
@@ -410,6 +456,9 @@ mod tests {
         let md = render_markdown(&cases, &skipped);
         assert!(md.contains("| arap | 1 / 0 / 0 / 1 | 1 / 0 / 0 / 1 |"), "{md}");
         assert!(md.contains("| skipped meshes | 1 | 1 |"), "{md}");
+        // Why suspect: hirm swells twice (suspect and unfinished) and folds once; arap is clean.
+        assert!(md.contains("| hirm | 0 | 1 | 0 | 0 | 0 | 2 | 0 | 0 |"), "{md}");
+        assert!(md.contains("| arap | 0 | 0 | 0 | 0 | 0 | 0 | 0 | 0 |"), "{md}");
         assert!(md.contains("skipped: bend-c (c.obj): face 3: zero area"), "{md}");
         assert!(render_markdown(&[CaseResult::empty("bar", "arap", "survey", 1, 1)], &[]).is_empty());
     }
