@@ -299,29 +299,11 @@ fn without_survey_data_the_procedural_look_alikes_run_and_are_labelled() {
     let index = reports.path().join("index.html");
     let page = std::fs::read_to_string(&index).unwrap();
     assert!(page.contains("Not checked"), "a procedural run is not compared with the survey baseline");
-    let Some(chromium) = chromium() else { return };
+    let Some(chromium) = support::chromium() else { return };
     let (loaded, total) = images_loaded_in_chromium(&chromium, &index);
     let expected = page.matches("<img ").count();
     assert!(expected >= 12, "index.html links {expected} images");
     assert_eq!((loaded, total), (expected, expected), "images loaded / present in index.html");
-}
-
-/// Debian's headless Chromium: `$DEFORMBENCH_CHROMIUM`, else `/usr/bin/chromium` (installed by
-/// `.ci/run`); a failure under `scripts/test` when missing, a skip otherwise.
-fn chromium() -> Option<PathBuf> {
-    let path = std::env::var_os("DEFORMBENCH_CHROMIUM")
-        .map_or_else(|| PathBuf::from("/usr/bin/chromium"), PathBuf::from);
-    if path.is_file() {
-        return Some(path);
-    }
-    if std::env::var("DEFORMBENCH_REQUIRE_CROSSCHECK").is_ok_and(|v| v == "1") {
-        panic!(
-            "{} not found: install Debian's chromium (see .ci/run) or set DEFORMBENCH_CHROMIUM",
-            path.display()
-        );
-    }
-    eprintln!("SKIPPED: no Chromium at {}", path.display());
-    None
 }
 
 /// Open `page` in headless Chromium and read the count its script writes into `#image-check`:
@@ -399,7 +381,7 @@ fn the_page_ranks_sorts_and_filters_as_its_address_asks_in_chromium() {
         run(&[&args[..], &["--reports", reports.path().to_str().unwrap()]].concat()).unwrap(),
         std::process::ExitCode::SUCCESS
     );
-    let Some(chromium) = chromium() else { return };
+    let Some(chromium) = support::chromium() else { return };
     let rows = support::csv_rows(&reports.path().join("results.csv"));
     let index = reports.path().join("index.html").canonicalize().unwrap();
     let url = format!("file://{}?sort=e_theta_deg&desc=1&status=ok&rank=e_phi_deg", index.display());

@@ -19,24 +19,6 @@ fn run(args: &[&str]) -> anyhow::Result<std::process::ExitCode> {
     harness::cli::run(full)
 }
 
-/// Debian's headless Chromium: `$DEFORMBENCH_CHROMIUM`, else `/usr/bin/chromium` (installed by
-/// `.ci/run`); a failure under `scripts/test` when missing, a skip otherwise.
-fn chromium() -> Option<PathBuf> {
-    let path = std::env::var_os("DEFORMBENCH_CHROMIUM")
-        .map_or_else(|| PathBuf::from("/usr/bin/chromium"), PathBuf::from);
-    if path.is_file() {
-        return Some(path);
-    }
-    if std::env::var("DEFORMBENCH_REQUIRE_CROSSCHECK").is_ok_and(|v| v == "1") {
-        panic!(
-            "{} not found: install Debian's chromium (see .ci/run) or set DEFORMBENCH_CHROMIUM",
-            path.display()
-        );
-    }
-    eprintln!("SKIPPED: no Chromium at {}", path.display());
-    None
-}
-
 /// The start tag of `<div id="viewer">` after headless Chromium (with `flags`) ran the page at
 /// `url`, and what Chromium said on stderr.
 fn viewer_after(chromium: &Path, url: &str, flags: &[&str]) -> (String, String) {
@@ -146,7 +128,7 @@ fn bar_report() -> (tempfile::TempDir, PathBuf) {
 
 #[test]
 fn the_view_draws_with_webgl2_and_without_it_on_the_2d_canvas_in_chromium() {
-    let Some(chromium) = chromium() else { return };
+    let Some(chromium) = support::chromium() else { return };
     let (_reports, index) = bar_report();
 
     // WebGL 2: the mesh where it is expected, both views loaded and drawn with timings.

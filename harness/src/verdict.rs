@@ -147,21 +147,19 @@ impl VerdictRules {
             // or scale it as the handles do, and no further.
             let (ratio, margin) = (1.0 + change, (1.0 + self.max_area_change_beyond_asked).ln());
             let (low, high) = (asked_scale.min(1.0).powi(2), asked_scale.max(1.0).powi(2));
-            let percent = |r: f64| 100.0 * (r - 1.0);
-            if ratio > 0.0 && ratio.ln() - high.ln() > margin {
-                reasons.push(format!(
-                    "swells: its surface area grew {:+.0}% where the handles ask at most {:+.0}% \
-                     (> {:.0}% beyond)",
-                    percent(ratio),
-                    percent(high),
-                    100.0 * self.max_area_change_beyond_asked
-                ));
+            let beyond = if ratio > 0.0 && ratio.ln() - high.ln() > margin {
+                Some(("swells", "grew", "at most", high))
             } else if ratio <= 0.0 || low.ln() - ratio.ln() > margin {
+                Some(("shrinks", "fell", "at least", low))
+            } else {
+                None
+            };
+            if let Some((kind, went, bound, asked)) = beyond {
                 reasons.push(format!(
-                    "shrinks: its surface area fell {:+.0}% where the handles ask at least {:+.0}% \
+                    "{kind}: its surface area {went} {:+.0}% where the handles ask {bound} {:+.0}% \
                      (> {:.0}% beyond)",
-                    percent(ratio),
-                    percent(low),
+                    100.0 * (ratio - 1.0),
+                    100.0 * (asked - 1.0),
                     100.0 * self.max_area_change_beyond_asked
                 ));
             }

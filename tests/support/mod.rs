@@ -160,3 +160,21 @@ pub fn timeless(case: &serde_json::Value) -> serde_json::Value {
     }
     c
 }
+
+/// Debian's headless Chromium: `$DEFORMBENCH_CHROMIUM`, else `/usr/bin/chromium` (installed by
+/// `.ci/run`); a failure under `scripts/test` when missing, a skip otherwise.
+pub fn chromium() -> Option<std::path::PathBuf> {
+    let path = std::env::var_os("DEFORMBENCH_CHROMIUM")
+        .map_or_else(|| std::path::PathBuf::from("/usr/bin/chromium"), std::path::PathBuf::from);
+    if path.is_file() {
+        return Some(path);
+    }
+    if std::env::var("DEFORMBENCH_REQUIRE_CROSSCHECK").is_ok_and(|v| v == "1") {
+        panic!(
+            "{} not found: install Debian's chromium (see .ci/run) or set DEFORMBENCH_CHROMIUM",
+            path.display()
+        );
+    }
+    eprintln!("SKIPPED: no Chromium at {}", path.display());
+    None
+}
