@@ -1350,6 +1350,81 @@ fn mesh_format_and_every_mesh_choose_the_result_files() {
     assert!(worst <= 1e-7 * off.bbox_diagonal(), "GLB positions {worst:e} from the OFF ones");
 }
 
+/// Issue 37: scenarios sharing `series` are one shape at several sizes: `size-series.md` has a row
+/// per case and per method a scenario left out (with its reason, also a note on the page), the
+/// fitted slopes, and `plots/size-series`. `left_out` naming no method, or without a reason, is
+/// refused; meshes above 200K vertices write no result mesh or view file unless asked.
+#[test]
+fn a_size_series_tabulates_its_cases_slopes_and_left_out_methods() {
+    let bar = |name: &str, n: usize, extra: &str| {
+        (
+            format!("{name}.toml"),
+            format!(
+                "name = \"{name}\"\nprocedural = {{ shape = \"bar\", vertices = {n} }}\nseries = \"bar\"\n\
+                 methods = [\"laplacian\", \"arap\", \"isolines\"]\n{extra}"
+            ),
+        )
+    };
+    let configs = configs_with(&[
+        bar("bar-a", 600, ""),
+        bar("bar-b", 1500, ""),
+        bar("bar-c", 3000, "[left_out]\nisolines = \"too slow here: 1 h measured\"\n"),
+    ]);
+    let reports = tempfile::tempdir().unwrap();
+    let args = ["--no-check"];
+    let mut full = vec!["all", "--quiet", "--configs", configs.path().to_str().unwrap()];
+    full.extend(["--reports", reports.path().to_str().unwrap()]);
+    full.extend(args);
+    assert_eq!(run(&full).unwrap(), std::process::ExitCode::SUCCESS);
+    let rows = support::csv_rows(&reports.path().join("results.csv"));
+    assert_eq!(rows.len(), 8, "3 methods x 3 sizes, less the one left out");
+    let md = std::fs::read_to_string(reports.path().join("size-series.md")).unwrap();
+    assert!(md.contains("## bar"), "{md}");
+    assert!(
+        md.contains("| isolines | bar-c |") && md.contains("left out: too slow here: 1 h measured"),
+        "{md}"
+    );
+    for method in ["laplacian", "arap"] {
+        let slopes =
+            md.lines().find(|l| l.starts_with(&format!("| {method} | ")) && l.ends_with(" 3 |")).unwrap();
+        let per_edit: f64 = slopes.split('|').nth(2).unwrap().trim().parse().unwrap();
+        assert!(per_edit > 0.0 && per_edit < 4.0, "{method}: time per edit grows with #V: {slopes}");
+    }
+    assert!(reports.path().join("plots/size-series.png").is_file());
+    let page = std::fs::read_to_string(reports.path().join("index.html")).unwrap();
+    assert!(page.contains("Cost against size") && page.contains("left out `isolines` on `bar-c`"));
+
+    use harness::scenario::{load_spec, DataSource};
+    let refused = |text: &str| {
+        let file = configs.path().join("refused.toml");
+        std::fs::write(&file, text).unwrap();
+        load_spec(&file).unwrap_err().to_string()
+    };
+    let e = refused("name = \"p\"\nprocedural = { shape = \"bar\" }\n[left_out]\narap = \" \"\n");
+    assert!(e.contains("left_out.arap") && e.contains("reason"), "{e}");
+    std::fs::write(
+        configs.path().join("scenarios/bar-d.toml"),
+        "name = \"d\"\nprocedural = { shape = \"bar\" }\n[left_out]\nhirn = \"x\"\n",
+    )
+    .unwrap();
+    let err = format!("{:#}", all_with(configs.path(), &reports.path().join("again")).unwrap_err());
+    assert!(err.contains("bar-d.toml") && err.contains("unknown method `hirn`"), "{err}");
+
+    let writes = |n: usize, extra: &str| {
+        let file = configs.path().join("size.toml");
+        std::fs::write(
+            &file,
+            format!("name = \"s\"\nprocedural = {{ shape = \"bar\", vertices = {n} }}\n{extra}"),
+        )
+        .unwrap();
+        load_spec(&file).unwrap().load(&DataSource::Procedural).unwrap().scenarios[0].writes_result_meshes()
+    };
+    assert!(writes(600, ""));
+    assert!(!writes(600, "result_meshes = false\n"));
+    assert!(!writes(250_000, ""), "above 200K vertices: only when asked");
+    assert!(writes(250_000, "result_meshes = true\n"));
+}
+
 /// Issue 24: a case stopped at its iteration cap is `unfinished` (with where it stopped) in the
 /// CSV and on the page, and the gate fails when a case that was `ok` in the baseline ends so.
 #[test]

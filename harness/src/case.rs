@@ -94,6 +94,9 @@ pub struct CaseResult {
     /// manifest row ([`crate::scenario::Member`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub member: Option<crate::scenario::Member>,
+    /// The size series its scenario is one size of (the scenario's `series`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub series: Option<String>,
     pub vertices: usize,
     pub faces: usize,
     /// The Laplacian weights the method ran with (`weights` in configs/methods.toml).
@@ -427,6 +430,7 @@ pub fn run_case(
     );
     result.origin = method.origin;
     result.member = scenario.member.clone();
+    result.series = scenario.spec.series.clone();
     result.sweeps = method.sweeps.clone();
     result.laplacian_weights = match method.origin {
         Origin::BuiltIn => laplacian_weights(params),
@@ -631,6 +635,7 @@ impl CaseResult {
             about: None,
             mesh_source: mesh_source.to_string(),
             member: None,
+            series: None,
             vertices,
             faces,
             laplacian_weights: String::new(),

@@ -176,12 +176,16 @@ pub fn publish(
         &publish.meshes,
     )?;
     let viewable = report::viewer::write_viewer_data(dir, &run.results, &run.scenarios, |s| {
-        publish.meshes.every_scenario || s.spec.writes_result_meshes()
+        publish.meshes.every_scenario || s.writes_result_meshes()
     })?;
     report::quality_time::write_markdown(dir, &run.results)?;
     let dataset = report::dataset::render_markdown(&run.results, &run.skipped);
     if !dataset.is_empty() {
         report::dataset::write_markdown(dir, &dataset)?;
+    }
+    let size_series = report::size_series::render_markdown(&run.results, &run.scenarios);
+    if !size_series.is_empty() {
+        report::size_series::write_markdown(dir, &size_series)?;
     }
     timed(RunPhase::Reports, start);
 
@@ -214,6 +218,7 @@ pub fn publish(
             &run.notes,
             &viewable,
             &dataset,
+            &size_series,
         ),
     )?;
     timed(RunPhase::GateAndIndex, start);

@@ -147,7 +147,7 @@ pub fn prepare(options: &SuiteOptions) -> Result<Prepared, HarnessError> {
     }
     let specs = select_specs(options)?;
     for spec in &specs {
-        for m in spec.methods.iter().flatten() {
+        for m in spec.methods.iter().flatten().chain(spec.left_out.keys()) {
             catalog.find(m).map_err(|message| HarnessError::Config { path: spec.path.clone(), message })?;
         }
     }
@@ -222,6 +222,7 @@ fn plan(options: &SuiteOptions, catalog: &MethodCatalog, scenarios: &[LoadedScen
                     Some(list) => list.contains(&m.name),
                     None => m.runs_on.as_ref().is_none_or(|on| on.contains(name)),
                 })
+                .filter(|m| !s.spec.left_out.contains_key(&m.name))
                 .map(|m| m.name.as_str())
                 .filter(|m| options.methods.is_empty() || options.methods.iter().any(|x| x == m))
                 .map(str::to_string)
@@ -293,6 +294,12 @@ fn notes_of(options: &SuiteOptions, scenarios: &[LoadedScenario], skipped: &[Ski
         .iter()
         .flat_map(|s| s.notes.iter().map(move |n| format!("scenario `{}`: {n}", s.spec.name)))
         .collect();
+    notes.extend(scenarios.iter().flat_map(|s| {
+        s.spec
+            .left_out
+            .iter()
+            .map(move |(method, why)| format!("left out `{method}` on `{}`: {why}", s.spec.name))
+    }));
     notes.extend(
         skipped
             .iter()

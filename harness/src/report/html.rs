@@ -43,6 +43,7 @@ pub fn render_index(
     notes: &[String],
     viewable: &[String],
     dataset: &str,
+    size_series: &str,
 ) -> String {
     let mut page = String::new();
     page.push_str(concat!(
@@ -122,6 +123,9 @@ pub fn render_index(
     };
     let (dataset_images, images): (Vec<&PathBuf>, Vec<&PathBuf>) =
         images.iter().filter(|p| p.extension().is_some_and(|e| e == "png")).partition(is_dataset);
+    let is_series =
+        |p: &&PathBuf| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("size-series"));
+    let (series_images, images): (Vec<&PathBuf>, Vec<&PathBuf>) = images.into_iter().partition(is_series);
     if !dataset.is_empty() {
         page.push_str(
             "<h2 id=\"dataset\">Across the dataset</h2>\n<p>The same tables as <code>dataset.md</code>: how often \
@@ -132,6 +136,17 @@ pub fn render_index(
         // The per-family headings of dataset.md, which markdown_table leaves out, as paragraphs.
         page.push_str(&markdown_table(&dataset.replace("\n### ", "\nEdit family: ")));
         for p in dataset_images {
+            image(&mut page, p, caption_for(p));
+        }
+    }
+    if !size_series.is_empty() {
+        page.push_str(
+            "<h2 id=\"size-series\">Cost against size</h2>\n<p>The same tables as <code>size-series.md</code>: one \
+             shape at several sizes, every case's time per phase, memory and status, the methods left out and why, and \
+             each method's fitted slopes against #V.</p>\n",
+        );
+        page.push_str(&markdown_table(&size_series.replace("\n## ", "\nSeries: ")));
+        for p in series_images {
             image(&mut page, p, caption_for(p));
         }
     }

@@ -34,6 +34,8 @@ const ERRORS_SIZE: (u32, u32) = (1500, 560);
 const ECDF_SIZE: (u32, u32) = (1500, 1100);
 /// Pixel size of the quality–time plot (three measures by two time axes).
 const PARETO_SIZE: (u32, u32) = (1600, 1500);
+/// Three panels side by side, each with a legend of (series, method) lines.
+const SIZE_SERIES_SIZE: (u32, u32) = (1800, 640);
 
 /// Method colours, fixed by registry order so a method has the same colour in every plot; the other
 /// methods (external, peers) of `cases` follow in their order there, which is the catalog's in every
@@ -114,6 +116,11 @@ pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, H
         written.extend(save(dir, "dataset-ecdf", &Plot::DatasetEcdf(&dataset))?);
         written.extend(save(dir, "dataset-cost", &Plot::DatasetCost(&dataset))?);
     }
+    let series: Vec<&CaseResult> =
+        crate::report::size_series::series_cases(results).into_values().flatten().collect();
+    if !series.is_empty() {
+        written.extend(save(dir, "size-series", &Plot::SizeSeries(&series))?);
+    }
     Ok(written)
 }
 
@@ -132,6 +139,8 @@ enum Plot<'a> {
     DatasetEcdf(&'a [&'a CaseResult]),
     /// The cases of a dataset run: time per edit and precompute against #V, fitted slopes.
     DatasetCost(&'a [&'a CaseResult]),
+    /// The cases of the size series: time per edit, precompute and peak memory against #V.
+    SizeSeries(&'a [&'a CaseResult]),
 }
 
 impl Plot<'_> {
@@ -142,6 +151,7 @@ impl Plot<'_> {
             Plot::Pareto(..) => PARETO_SIZE,
             Plot::DatasetEcdf(..) => ECDF_SIZE,
             Plot::DatasetCost(..) => ERRORS_SIZE,
+            Plot::SizeSeries(..) => SIZE_SERIES_SIZE,
             _ => SIZE,
         }
     }
@@ -156,6 +166,7 @@ impl Plot<'_> {
             Plot::Pareto(scenario, cases) => draw_pareto(root, scenario, cases),
             Plot::DatasetEcdf(cases) => draw_dataset_ecdf(root, cases),
             Plot::DatasetCost(cases) => draw_dataset_cost(root, cases),
+            Plot::SizeSeries(cases) => draw_size_series(root, cases),
         }
     }
 }
@@ -670,6 +681,89 @@ fn draw_dataset_cost<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResul
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
         }
         draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, 13)?;
+    }
+    Ok(())
+}
+
+/// The size series' cost against #V: time per edit, precompute and peak memory on log-log axes, a
+/// marker per case that ran and a line through each (series, method)'s sizes, its fitted slope in
+/// the legend. Colour says the method, the marker the series (circle, triangle, square, ...).
+fn draw_size_series<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult]) -> DrawResult {
+    use crate::report::dataset::{cost_slope, methods_of};
+    root.fill(&WHITE).map_err(err)?;
+    let root = root
+        .titled("Cost against size: one shape at several sizes (log-log, fitted slopes)", ("sans-serif", 22))
+        .map_err(err)?;
+    let methods = methods_of(cases);
+    let mut series: Vec<&str> = cases.iter().filter_map(|c| c.series.as_deref()).collect();
+    series.sort();
+    series.dedup();
+    let panels: [(&str, &str, fn(&CaseResult) -> f64); 3] = [
+        ("time per edit, bind + solve", "seconds", |c| c.bind_s + c.solve_s),
+        ("precompute", "seconds", |c| c.precompute_s),
+        ("peak memory", "MiB", |c| c.peak_memory_mib),
+    ];
+    for (panel, (label, unit, value)) in root.split_evenly((1, 3)).into_iter().zip(panels) {
+        let points = |s: &str, m: &str| -> Vec<(f64, f64)> {
+            let mut p: Vec<(f64, f64)> = cases
+                .iter()
+                .filter(|c| c.series.as_deref() == Some(s) && c.method == m && !c.status.is_failed())
+                .map(|c| (c.vertices as f64, value(c)))
+                .filter(|(v, y)| *v > 0.0 && y.is_finite() && *y > 0.0)
+                .collect();
+            p.sort_by(|a, b| a.0.total_cmp(&b.0));
+            p
+        };
+        let all: Vec<(f64, f64)> =
+            series.iter().flat_map(|s| methods.iter().flat_map(move |m| points(s, m))).collect();
+        let (x0, x1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
+        let (y0, y1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
+        if !x0.is_finite() {
+            continue;
+        }
+        let mut chart = ChartBuilder::on(&panel)
+            .caption(label, ("sans-serif", 18))
+            .margin(10)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d((x0 * 0.8..x1 * 1.25).log_scale(), (y0 * 0.5..y1 * 2.0).log_scale())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("vertices")
+            .y_desc(unit)
+            .x_labels(6)
+            .x_label_formatter(&|v| vertex_count_label(*v))
+            .y_label_formatter(&|v| format!("{}", round_to_two_digits(*v)))
+            .label_style(("sans-serif", 13))
+            .draw()
+            .map_err(err)?;
+        for (k, s) in series.iter().enumerate() {
+            for m in &methods {
+                let p = points(s, m);
+                if p.is_empty() {
+                    continue;
+                }
+                let color = method_color(m, cases);
+                let style = color.stroke_width(if k == 0 { 2 } else { 1 });
+                let (slope, _) = cost_slope(p.iter().map(|(v, y)| (*v as usize, *y)));
+                let slope = if slope.is_finite() { format!("{slope:.2}") } else { "–".into() };
+                chart
+                    .draw_series(LineSeries::new(p.clone(), style))
+                    .map_err(err)?
+                    .label(format!("{s}: {m} (slope {slope})"))
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
+                for q in p {
+                    let marker: DynElement<DB, (f64, f64)> = match k % 3 {
+                        0 => Circle::new(q, 4, color.filled()).into_dyn(),
+                        1 => TriangleMarker::new(q, 5, color.filled()).into_dyn(),
+                        _ => Cross::new(q, 4, color.stroke_width(2)).into_dyn(),
+                    };
+                    chart.draw_series(std::iter::once(marker)).map_err(err)?;
+                }
+            }
+        }
+        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, 12)?;
     }
     Ok(())
 }

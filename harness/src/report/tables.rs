@@ -417,7 +417,7 @@ fn write_meshes(
         else {
             continue;
         };
-        if !(output.every_scenario || scenario.spec.writes_result_meshes()) {
+        if !(output.every_scenario || scenario.writes_result_meshes()) {
             continue;
         }
         // In the input file's vertex order, so per-vertex data of the input still applies.

@@ -120,8 +120,19 @@ pub struct ScenarioSpec {
     /// Methods to run (default: all registered).
     #[serde(default)]
     pub methods: Option<Vec<String>>,
-    /// Whether reports write this scenario's result meshes (default `true`; the resolution sweeps
-    /// say `false`, and `--every-mesh` writes them anyway).
+    /// Methods that would run here but are left out, each with the reason and the measured figure
+    /// behind it (`left_out = { scale_aware = "..." }`): subtracted from `methods` (or the
+    /// default), and each one a note of the run and a row of `size-series.md`, so a method that
+    /// cannot run at a size is reported, not silently missing.
+    #[serde(default)]
+    pub left_out: std::collections::BTreeMap<String, String>,
+    /// One shape at several sizes: the scenarios that share a `series` name are one line per
+    /// method in `plots/size-series` and one table in `size-series.md` (time per phase, memory and
+    /// fitted slopes against #V). E.g. `"igea"` for igea refined 0, 1 and 2 times.
+    #[serde(default)]
+    pub series: Option<String>,
+    /// Whether reports write this scenario's result meshes and the 3D view's files (default: for
+    /// meshes up to [`RESULT_MESHES_MAX_VERTICES`]; `--every-mesh` writes them anyway).
     #[serde(default)]
     pub result_meshes: Option<bool>,
     /// Edit steps (default: the first edit alone, the survey's or the `[[regions]]`).
@@ -271,6 +282,11 @@ pub enum DataSource {
     Procedural,
 }
 
+/// Above this many vertices a scenario's result meshes and 3D-view files are written only when it
+/// says `result_meshes = true` or the run asks `--every-mesh`: a 1M-vertex case writes 24 MB of
+/// `.glb` and 20 MB of view data, and a page of such cases stops being something to open.
+pub const RESULT_MESHES_MAX_VERTICES: usize = 200_000;
+
 /// A scenario ready to run: validated mesh, handles and targets.
 pub struct LoadedScenario {
     pub spec: ScenarioSpec,
@@ -342,6 +358,12 @@ pub struct InputMesh {
 }
 
 impl LoadedScenario {
+    /// Whether reports write this scenario's result meshes and 3D-view files by default: its
+    /// `result_meshes`, else whether the mesh has at most [`RESULT_MESHES_MAX_VERTICES`].
+    pub fn writes_result_meshes(&self) -> bool {
+        self.spec.result_meshes.unwrap_or(self.mesh.n_vertices() <= RESULT_MESHES_MAX_VERTICES)
+    }
+
     /// `#V x 3` positions on this scenario's mesh from positions in the input file's vertex order (the
     /// inverse of [`LoadedScenario::in_input_order`]).
     pub fn from_input_order(&self, positions: &[[f64; 3]]) -> Result<Vec<[f64; 3]>, String> {
@@ -453,7 +475,13 @@ pub fn load_spec(path: &Path) -> Result<ScenarioSpec, HarnessError> {
             )));
         }
     }
-    // The names in `methods` are checked against the run's methods (configs/methods.toml and any
+    if let Some((method, _)) = spec.left_out.iter().find(|(_, why)| why.trim().is_empty()) {
+        return Err(config(format!("left_out.{method}: give the reason it is left out (a measured figure)")));
+    }
+    if spec.series.as_deref().is_some_and(|s| s.trim().is_empty()) {
+        return Err(config("`series` names the shape a size series is of; it cannot be empty".into()));
+    }
+    // The names in `methods` and `left_out` are checked against the run's methods (configs/methods.toml and any
     // peers) when the run is prepared.
     Ok(spec)
 }
@@ -520,11 +548,6 @@ impl SelectionFiles for InputFiles {
 }
 
 impl ScenarioSpec {
-    /// Whether reports write the result meshes of this scenario by default (`result_meshes`).
-    pub fn writes_result_meshes(&self) -> bool {
-        self.result_meshes.unwrap_or(true)
-    }
-
     /// Where this scenario's relative paths start.
     fn paths(&self, stem: Option<String>) -> PathContext {
         let base = self.path.parent().map(Path::to_path_buf).unwrap_or_default();

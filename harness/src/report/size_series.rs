@@ -1,0 +1,175 @@
+//! `size-series.md`: how each method's cost grows with the mesh on one shape at several sizes.
+//!
+//! A size series is the scenarios that share a `series` name (the procedural bar at 6K to 1M, igea
+//! refined 0 to 2 times). Per series: a table of every case (method × size: precompute, bind,
+//! solve, iterations, peak memory, status) with the methods a scenario left out and why, then each
+//! method's fitted slopes of log cost against log #V ([`crate::report::dataset::cost_slope`]), so
+//! a real shape's growth reads beside the procedural bar's. The plot is `plots/size-series`.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use crate::case::CaseResult;
+use crate::scenario::LoadedScenario;
+
+/// The quantities whose growth with #V is fitted, with how each reads off a case.
+pub const SLOPE_QUANTITIES: [(&str, fn(&CaseResult) -> f64); 4] = [
+    ("time per edit (bind + solve)", |c| c.bind_s + c.solve_s),
+    ("per iteration", |c| c.median_iteration_ms),
+    ("precompute", |c| c.precompute_s),
+    ("peak memory", |c| c.peak_memory_mib),
+];
+
+/// The cases of each series with at least two mesh sizes, by series name.
+pub fn series_cases(results: &[CaseResult]) -> BTreeMap<&str, Vec<&CaseResult>> {
+    let mut out: BTreeMap<&str, Vec<&CaseResult>> = BTreeMap::new();
+    for r in results {
+        if let Some(s) = &r.series {
+            out.entry(s.as_str()).or_default().push(r);
+        }
+    }
+    out.retain(|_, cases| {
+        let first = cases[0].vertices;
+        cases.iter().any(|c| c.vertices != first)
+    });
+    out
+}
+
+/// `size-series.md` for the series of `results`; the methods each scenario of a series left out
+/// (its `left_out`) are rows too. Empty when the run has no series of two sizes or more.
+pub fn render_markdown(results: &[CaseResult], scenarios: &[LoadedScenario]) -> String {
+    let series = series_cases(results);
+    if series.is_empty() {
+        return String::new();
+    }
+    let mut md = String::from(
+        "# Cost against size\n\nOne shape at several sizes (scenarios sharing `series`): each case's time per phase, \
+         iterations, peak memory (what the method added; 0 when the allocator reused memory) and status, then \
+         each method's fitted slope of log cost against log #V (least squares over the sizes that ran; – for \
+         fewer than three).\n",
+    );
+    for (name, cases) in &series {
+        let mut sizes: Vec<(usize, &str)> = cases.iter().map(|c| (c.vertices, c.scenario.as_str())).collect();
+        sizes.sort();
+        sizes.dedup();
+        let methods = crate::report::dataset::methods_of(cases);
+        let _ = writeln!(md, "\n## {name}\n");
+        md.push_str(
+            "| method | scenario | #V | precompute | bind | solve | iterations | peak memory | status |\n",
+        );
+        md.push_str("|---|---|---:|---:|---:|---:|---:|---:|---|\n");
+        for m in &methods {
+            for (vertices, scenario) in &sizes {
+                if let Some(c) = cases.iter().find(|c| c.method == *m && c.scenario == *scenario) {
+                    let _ = writeln!(
+                        md,
+                        "| {m} | {scenario} | {vertices} | {} | {} | {} | {} | {} | {} |",
+                        seconds(c.precompute_s),
+                        seconds(c.bind_s),
+                        seconds(c.solve_s),
+                        c.iterations,
+                        mebibytes(c.peak_memory_mib),
+                        c.status
+                    );
+                } else if let Some(why) = left_out(scenarios, scenario, m) {
+                    let _ = writeln!(
+                        md,
+                        "| {m} | {scenario} | {vertices} | – | – | – | – | – | left out: {why} |"
+                    );
+                }
+            }
+        }
+        md.push_str("\n| method |");
+        for (label, _) in SLOPE_QUANTITIES {
+            let _ = write!(md, " slope: {label} |");
+        }
+        md.push_str(" sizes |\n|---|");
+        md.push_str(&"---:|".repeat(SLOPE_QUANTITIES.len() + 1));
+        md.push('\n');
+        for m in &methods {
+            let ran: Vec<&&CaseResult> =
+                cases.iter().filter(|c| c.method == *m && !c.status.is_failed()).collect();
+            let _ = write!(md, "| {m} |");
+            for (_, quantity) in SLOPE_QUANTITIES {
+                let (slope, _) =
+                    crate::report::dataset::cost_slope(ran.iter().map(|c| (c.vertices, quantity(c))));
+                let _ =
+                    write!(md, " {} |", if slope.is_finite() { format!("{slope:.2}") } else { "–".into() });
+            }
+            let _ = writeln!(md, " {} |", ran.len());
+        }
+    }
+    md
+}
+
+/// Why `scenario` left `method` out, if it did.
+fn left_out<'a>(scenarios: &'a [LoadedScenario], scenario: &str, method: &str) -> Option<&'a str> {
+    scenarios.iter().find(|s| s.spec.name == scenario)?.spec.left_out.get(method).map(String::as_str)
+}
+
+/// Seconds for a table: `12.3 ms`, `4.56 s`; `–` when not measured.
+fn seconds(s: f64) -> String {
+    if !s.is_finite() {
+        "–".into()
+    } else if s < 1.0 {
+        format!("{:.3} ms", s * 1e3).replace(".000 ms", " ms")
+    } else {
+        format!("{s:.2} s")
+    }
+}
+
+/// MiB for a table, as GiB above 1024; `–` when not measured.
+fn mebibytes(m: f64) -> String {
+    if !m.is_finite() {
+        "–".into()
+    } else if m >= 1024.0 {
+        format!("{:.2} GiB", m / 1024.0)
+    } else {
+        format!("{m:.0} MiB")
+    }
+}
+
+/// Write `markdown` to `dir/size-series.md` (atomically).
+pub fn write_markdown(dir: &std::path::Path, markdown: &str) -> Result<(), crate::error::HarnessError> {
+    meshes::io::atomic_write(dir.join("size-series.md"), |w| {
+        std::io::Write::write_all(w, markdown.as_bytes()).map_err(meshes::MeshError::from)
+    })
+    .map_err(crate::error::HarnessError::from)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn case(scenario: &str, method: &str, vertices: usize, seconds: f64) -> CaseResult {
+        let mut c = CaseResult::empty(scenario, method, "procedural", vertices, 2 * vertices);
+        c.series = Some("bar".into());
+        c.status = "ok".parse().unwrap();
+        c.precompute_s = seconds;
+        c.bind_s = seconds;
+        c.solve_s = seconds;
+        c.median_iteration_ms = 1.0;
+        c.peak_memory_mib = vertices as f64 / 1000.0;
+        c
+    }
+
+    #[test]
+    fn a_series_of_power_laws_reads_its_exponents() {
+        // Time grows as #V^1.5, memory as #V, the iteration not at all.
+        let results: Vec<CaseResult> = [1_000usize, 10_000, 100_000]
+            .iter()
+            .map(|&v| case(&format!("bar-{v}"), "arap", v, (v as f64).powf(1.5) * 1e-6))
+            .collect();
+        let md = render_markdown(&results, &[]);
+        assert!(md.contains("## bar"), "{md}");
+        assert!(md.contains("| arap | 1.50 | 0.00 | 1.50 | 1.00 | 3 |"), "{md}");
+        assert!(md.contains("| arap | bar-100000 | 100000 |"), "{md}");
+    }
+
+    #[test]
+    fn one_size_is_no_series() {
+        let results = vec![case("bar-a", "arap", 1_000, 1.0), case("bar-b", "hirm", 1_000, 1.0)];
+        assert!(series_cases(&results).is_empty());
+        assert!(render_markdown(&results, &[]).is_empty());
+    }
+}
