@@ -154,6 +154,18 @@ fn the_view_draws_with_webgl2_and_without_it_on_the_2d_canvas_in_chromium() {
     assert!(spun.number("data-spin-ms") > 0.0);
     assert!(spun.number("data-picked") >= 0.0, "picked vertex {}", spun.get("data-picked"));
 
+    // Above `turning=N` faces a turning redraw draws a coarser copy of the mesh (vertex clusters),
+    // closed where the mesh is: about as many pixels as the full mesh; once the turning stops the
+    // full mesh is drawn again, the very picture drawn without the copy.
+    let coarse =
+        Drawn::open(&chromium, &index, "view=bar-arap&left=laplacian&spin=5&pick=320,260&turning=400", WEBGL);
+    let faces = coarse.number("data-turning-faces");
+    assert!(faces > 100.0 && faces < 1_000.0, "{faces} faces while turning (the bar has about 4,000)");
+    assert!(spun.number("data-turning-faces") > 3_000.0, "below the threshold every face is drawn");
+    let (turning, still) = (coarse.number("data-turning-pixels"), coarse.number("data-pixels"));
+    assert!((turning - still).abs() < 0.1 * still, "{turning} pixels while turning, {still} at rest");
+    assert_eq!(coarse.get("data-checksum"), spun.get("data-checksum"), "the full mesh once turning stops");
+
     // No WebGL: the 2D canvas draws the same views, colours and picks.
     let fallback = Drawn::open(&chromium, &index, "view=bar-arap&colour=shaded&pick=320,260", NO_WEBGL);
     fallback.assert_drawn("canvas", 5_000.0);

@@ -15,8 +15,9 @@
 // data-left, data-pixels (non-background pixels of the smaller view), data-checksum (of both
 // pictures), data-centre (the left view's centre pixel), data-load-ms (opening to first picture),
 // data-redraw-ms (the last redraw, GPU work included) and, after `spin=N` in the address, data-spin-ms
-// (the median of N redraws turning 0.05 rad each); `yaw=` turns the first picture and `pick=x,y`
-// clicks the right view there.
+// (the median of N redraws turning 0.05 rad each, drawn as a drag draws them), data-turning-faces
+// (the faces a view draws while turning: all of them, or a coarser copy's above `turning=N`,
+// default 300,000) and data-turning-pixels (data-pixels of the last turning redraw); `yaw=` turns the first picture and `pick=x,y` clicks the right view there.
 (function () {
   'use strict';
   var box = document.getElementById('viewer');
@@ -100,6 +101,62 @@
       };
     }
     return d.mesh;
+  }
+
+  // While turning, a mesh of more than `turningFaces` faces is drawn from a coarser copy, and the
+  // full mesh again once the pointer is let go: a software GPU's redraw costs about 0.3 us per face
+  // drawn, and a drag needs a picture every few tenths of a second. The copy clusters the rest
+  // mesh's vertices on a grid (the first vertex of each occupied cell stands for the cell) and keeps
+  // one face per triple of distinct cells that faces join, with the colour of the first: closed
+  // where the mesh is (no holes, unlike drawing every k-th face), on the same vertices, so every view
+  // of the test uses it with its own positions. `turning=N` in the address sets the threshold.
+  var turningFaces = parseInt(params.get('turning'), 10) || 300000;
+  function turningMesh(rest) {
+    if (rest.turning !== undefined) return rest.turning;
+    var t = rest.triangles, n = t.length / 3, p = rest.positions, nv = p.length / 3;
+    rest.turning = null;
+    if (n <= turningFaces) return null;
+    var lo = [1e30, 1e30, 1e30], hi = [-1e30, -1e30, -1e30];
+    for (var i = 0; i < p.length; i++) { lo[i % 3] = Math.min(lo[i % 3], p[i]); hi[i % 3] = Math.max(hi[i % 3], p[i]); }
+    var size = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
+    var cellOf = new Int32Array(nv);
+    // A surface occupies about c N^2 cells of an N^3 grid and a clustered surface has about twice as
+    // many faces as cells: one trial grid, then the one that gives about half turningFaces cells.
+    function cluster(cells) {
+      var first = new Map(), rep = new Int32Array(nv), h = size / cells;
+      for (var v = 0; v < nv; v++) {
+        var key = (Math.floor((p[3 * v] - lo[0]) / h) * (cells + 1) + Math.floor((p[3 * v + 1] - lo[1]) / h)) * (cells + 1) +
+          Math.floor((p[3 * v + 2] - lo[2]) / h);
+        var r = first.get(key);
+        if (r === undefined) { r = v; first.set(key, v); }
+        rep[v] = r;
+      }
+      return { rep: rep, occupied: first.size };
+    }
+    var trial = cluster(64), cells = Math.max(8, Math.round(64 * Math.sqrt(turningFaces / 2 / trial.occupied)));
+    var rep = cluster(cells).rep, kept = new Map(), triangles = [], faces = [];
+    for (var f = 0; f < n; f++) {
+      var a = rep[t[3 * f]], b = rep[t[3 * f + 1]], c = rep[t[3 * f + 2]];
+      if (a === b || b === c || c === a) continue;
+      var x = Math.min(a, b, c), z = Math.max(a, b, c), y = a + b + c - x - z, key = x * nv + y;
+      var seen = kept.get(key);
+      if (seen === undefined) kept.set(key, [z]); else if (seen.indexOf(z) >= 0) continue; else seen.push(z);
+      triangles.push(a, b, c);
+      faces.push(f);
+    }
+    if (triangles.length / 3 >= n) return null;
+    rest.turning = { triangles: new Uint32Array(triangles), faces: new Uint32Array(faces) };
+    return rest.turning;
+  }
+
+  // The colours of the turning mesh's faces: each its first face's.
+  function turningColours(turning, colours) {
+    var out = new Uint8Array(3 * turning.faces.length);
+    for (var f = 0; f < turning.faces.length; f++) {
+      var o = 3 * turning.faces[f];
+      out[3 * f] = colours[o]; out[3 * f + 1] = colours[o + 1]; out[3 * f + 2] = colours[o + 2];
+    }
+    return out;
   }
 
   // The farthest any shown point lies from the rest mesh's centre: the depth range the GPU keeps
@@ -239,12 +296,17 @@
   // ---- The 2D canvas renderer (no WebGL): every face sorted and filled per redraw.
 
   function canvasRenderer(canvas) {
-    var ctx = canvas.getContext('2d'), mesh = null, colours = null;
+    var ctx = canvas.getContext('2d'), mesh = null, colours = null, coarse = null, coarseColours = null;
     return {
       kind: 'canvas',
-      setMesh: function (view, triangles) { mesh = { positions: view.positions, triangles: triangles }; },
-      setColours: function (c) { colours = c; },
-      draw: function (view) { paintFaces(ctx, view, mesh, colours); },
+      setMesh: function (view, triangles, turning) {
+        mesh = { positions: view.positions, triangles: triangles };
+        coarse = turning ? { positions: view.positions, triangles: turning.triangles, faces: turning.faces } : null;
+      },
+      setColours: function (c) { colours = c; coarseColours = coarse ? turningColours(coarse, c) : null; },
+      draw: function (view, turning) {
+        if (turning && coarse) paintFaces(ctx, view, coarse, coarseColours); else paintFaces(ctx, view, mesh, colours);
+      },
       // Reading a pixel waits for the drawing to land, so a redraw's time is the real one.
       finish: function () { ctx.getImageData(0, 0, 1, 1); },
       image: function () { return ctx.getImageData(0, 0, canvas.width, canvas.height).data; },
@@ -388,22 +450,13 @@
   }
 
   function webglRenderer(canvas, gl, restored) {
-    var w = canvas.width, h = canvas.height, gpu = null, source = {}, corners = 0;
+    var w = canvas.width, h = canvas.height, gpu = null, source = {}, corners = 0, coarseCorners = 0;
     // Everything the GPU holds; made again if the browser takes the context away and gives it back.
     function setUp() {
       gpu = {
         draw: compiled(gl, DRAW_VERTEX, DRAW_FRAGMENT), pick: compiled(gl, PICK_VERTEX, PICK_FRAGMENT),
-        shape: gl.createVertexArray(), positions: gl.createBuffer(), colours: gl.createBuffer(),
-        ids: gl.createFramebuffer()
+        full: shape(), coarse: shape(), ids: gl.createFramebuffer()
       };
-      gl.bindVertexArray(gpu.shape);
-      gl.bindBuffer(gl.ARRAY_BUFFER, gpu.positions);
-      gl.enableVertexAttribArray(0);
-      gl.vertexAttribPointer(0, 3, gl.UNSIGNED_SHORT, true, 0, 0);
-      gl.bindBuffer(gl.ARRAY_BUFFER, gpu.colours);
-      gl.enableVertexAttribArray(1);
-      gl.vertexAttribPointer(1, 4, gl.UNSIGNED_BYTE, true, 0, 0);
-      gl.bindVertexArray(null);
       // The face-number image for picking: 32-bit face numbers with their own depth test.
       gl.bindFramebuffer(gl.FRAMEBUFFER, gpu.ids);
       [[gl.R32UI, gl.COLOR_ATTACHMENT0], [gl.DEPTH_COMPONENT24, gl.DEPTH_ATTACHMENT]].forEach(function (a) {
@@ -416,34 +469,51 @@
       gl.enable(gl.DEPTH_TEST);
       gl.clearColor(1, 1, 1, 1);
     }
+    // A vertex array of u16 corner positions and RGBA corner colours, each in a buffer of its own.
+    function shape() {
+      var s = { array: gl.createVertexArray(), positions: gl.createBuffer(), colours: gl.createBuffer() };
+      gl.bindVertexArray(s.array);
+      gl.bindBuffer(gl.ARRAY_BUFFER, s.positions);
+      gl.enableVertexAttribArray(0);
+      gl.vertexAttribPointer(0, 3, gl.UNSIGNED_SHORT, true, 0, 0);
+      gl.bindBuffer(gl.ARRAY_BUFFER, s.colours);
+      gl.enableVertexAttribArray(1);
+      gl.vertexAttribPointer(1, 4, gl.UNSIGNED_BYTE, true, 0, 0);
+      gl.bindVertexArray(null);
+      return s;
+    }
     function upload(buffer, array) {
       gl.bindBuffer(gl.ARRAY_BUFFER, buffer);
       gl.bufferData(gl.ARRAY_BUFFER, array, gl.STATIC_DRAW);
     }
-    function drawWith(program, view) {
+    function drawWith(program, view, turning) {
+      var coarse = turning && coarseCorners > 0;
       gl.useProgram(program.program);
       gl.uniformMatrix4fv(program.camera, false, cameraMatrix(view, source.packed.lo, source.packed.hi));
       gl.uniform3f(program.toClip, 2 / w, 2 / h, 1 / view.depthRange);
-      gl.bindVertexArray(gpu.shape);
-      gl.drawArrays(gl.TRIANGLES, 0, corners);
+      gl.bindVertexArray(coarse ? gpu.coarse.array : gpu.full.array);
+      gl.drawArrays(gl.TRIANGLES, 0, coarse ? coarseCorners : corners);
       gl.bindVertexArray(null);
     }
     var renderer = {
       kind: 'webgl2',
-      setMesh: function (view, triangles) {
+      setMesh: function (view, triangles, turning) {
         if (source.packed && source.packed.values === view.packed.values && source.triangles === triangles) return;
-        source.packed = view.packed; source.triangles = triangles;
-        upload(gpu.positions, cornerPositions(view.packed.values, triangles));
+        source.packed = view.packed; source.triangles = triangles; source.turning = turning;
+        upload(gpu.full.positions, cornerPositions(view.packed.values, triangles));
         corners = triangles.length;
+        upload(gpu.coarse.positions, turning ? cornerPositions(view.packed.values, turning.triangles) : new Uint16Array(0));
+        coarseCorners = turning ? turning.triangles.length : 0;
       },
       setColours: function (colours) {
         source.colours = colours;
-        upload(gpu.colours, cornerColours(colours));
+        upload(gpu.full.colours, cornerColours(colours));
+        upload(gpu.coarse.colours, source.turning ? cornerColours(turningColours(source.turning, colours)) : new Uint8Array(0));
       },
-      draw: function (view) {
+      draw: function (view, turning) {
         gl.viewport(0, 0, w, h);
         gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
-        drawWith(gpu.draw, view);
+        drawWith(gpu.draw, view, turning);
       },
       // Reading a pixel waits for the GPU, so a redraw's time is the real one.
       finish: function () { gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4)); },
@@ -476,7 +546,7 @@
       var was = source;
       setUp();
       source = {};
-      if (was.packed) renderer.setMesh({ packed: was.packed }, was.triangles);
+      if (was.packed) renderer.setMesh({ packed: was.packed }, was.triangles, was.turning);
       if (was.colours) renderer.setColours(was.colours);
       restored();
     });
@@ -514,12 +584,13 @@
 
   // ---- Drawing.
 
-  // Draw both views from the camera; returns the milliseconds it took, the GPU's work included.
-  function redraw() {
+  // Draw both views from the camera (from the turning mesh when `turning`); returns the
+  // milliseconds it took, the GPU's work included.
+  function redraw(turning) {
     if (!shown) return 0;
     if (shown.colouredBy !== colourBy.value) recolour();
     var started = performance.now();
-    renderers.forEach(function (r, k) { r.draw(cameraView(canvases[k])); });
+    renderers.forEach(function (r, k) { r.draw(cameraView(canvases[k]), turning === true); });
     renderers.forEach(function (r) { r.finish(); });
     var ms = performance.now() - started;
     box.dataset.redrawMs = ms.toFixed(1);
@@ -546,19 +617,24 @@
   function describe() {
     if (!shown) return;
     var images = renderers.map(function (r) { return r.image(); }), hash = 2166136261;
-    box.dataset.pixels = Math.min.apply(null, images.map(function (pixels) {
-      var count = 0;
-      for (var i = 0; i < pixels.length; i += 4) {
-        if (pixels[i] < 250 || pixels[i + 1] < 250 || pixels[i + 2] < 250) count++;
-      }
-      return count;
-    }));
+    box.dataset.pixels = drawnPixels(images);
     images.forEach(function (pixels) {
       for (var i = 0; i < pixels.length; i++) hash = Math.imul(hash ^ pixels[i], 16777619);
     });
     box.dataset.checksum = (hash >>> 0).toString(16);
     var left = canvases[0], centre = 4 * (left.width * (left.height >> 1) + (left.width >> 1));
     box.dataset.centre = Array.prototype.slice.call(images[0], centre, centre + 3).join(',');
+  }
+
+  // The non-background pixels of the smaller of `images` (RGBA, as `image()` gives them).
+  function drawnPixels(images) {
+    return Math.min.apply(null, images.map(function (pixels) {
+      var count = 0;
+      for (var i = 0; i < pixels.length; i += 4) {
+        if (pixels[i] < 250 || pixels[i + 1] < 250 || pixels[i + 2] < 250) count++;
+      }
+      return count;
+    }));
   }
 
   // One redraw for the events that came while the last one drew, however many: the redraw runs
@@ -575,10 +651,13 @@
     var times = [];
     for (var i = 0; i < n; i++) {
       camera.yaw += 0.05;
-      times.push(redraw());
+      times.push(redraw(true));
     }
     times.sort(function (a, b) { return a - b; });
-    if (n > 0) box.dataset.spinMs = times[(n - 1) >> 1].toFixed(1);
+    if (n > 0) {
+      box.dataset.spinMs = times[(n - 1) >> 1].toFixed(1);
+      box.dataset.turningPixels = drawnPixels(renderers.map(function (r) { return r.image(); }));
+    }
     show();
   }
 
@@ -655,7 +734,9 @@
     }
     shown = { rest: rest, views: views, reach: reachOf(rest.center, views.map(function (v) { return v.positions; })),
       colouredBy: null, picked: null };
-    renderers.forEach(function (r, k) { r.setMesh(views[k], rest.triangles); });
+    var turning = turningMesh(rest);
+    box.dataset.turningFaces = turning ? turning.faces.length : rest.triangles.length / 3;
+    renderers.forEach(function (r, k) { r.setMesh(views[k], rest.triangles, turning); });
     views.forEach(function (v, k) { if (names[k]) names[k].textContent = v.method; });
     delete box.dataset.picked;
     notePicks();
@@ -736,7 +817,7 @@
       camera.yaw += 0.01 * dx;
       camera.pitch = Math.max(-1.5, Math.min(1.5, camera.pitch + 0.01 * dy));
       drag.last = [e.clientX, e.clientY];
-      onNextFrame(redraw);
+      onNextFrame(function () { redraw(true); });
     });
     pane.addEventListener('wheel', function (e) {
       e.preventDefault();
