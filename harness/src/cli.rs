@@ -145,8 +145,9 @@ struct Peers {
     /// quality–time plots and budget table (README "Sweeps").
     #[arg(long)]
     sweeps: bool,
-    /// The cross-check Python with libigl and open3d (`scripts/python-env` prints it).
-    #[arg(long, env = peers::PYTHON_ENV)]
+    /// The cross-check Python with libigl and open3d (`scripts/python-env` prints it) [env:
+    /// DEFORMBENCH_PYTHON; empty counts as unset].
+    #[arg(long)]
     python: Option<PathBuf>,
 }
 
@@ -157,7 +158,7 @@ impl Peers {
         if !self.peers {
             return None;
         }
-        Some(match &self.python {
+        Some(match &self.python_path() {
             Some(p) if p.is_file() => Ok(PeerSetup { file: configs_dir.join("peers.toml"), python: p.clone() }),
             Some(p) => Err(format!("peers not run: the Python {} does not exist", p.display())),
             None => Err(format!(
@@ -168,12 +169,17 @@ impl Peers {
         })
     }
 
+    /// `--python`, else `DEFORMBENCH_PYTHON` when set and not empty.
+    fn python_path(&self) -> Option<PathBuf> {
+        self.python.clone().or_else(|| path_from_env(peers::PYTHON_ENV))
+    }
+
     /// The Python to run the peer checks with, if they were asked for.
     fn python(&self) -> anyhow::Result<Option<PathBuf>> {
         if !self.self_intersections {
             return Ok(None);
         }
-        match &self.python {
+        match &self.python_path() {
             Some(p) if p.is_file() => Ok(Some(p.clone())),
             Some(p) => anyhow::bail!("--python {}: no such file", p.display()),
             None => anyhow::bail!(
@@ -197,7 +203,7 @@ struct Gate {
 struct Common {
     /// Directory with the survey's .off/.sel/.def files [env: DEFORM_SURVEY_DIR]. Without it the
     /// procedural look-alikes are used, and every report says so.
-    #[arg(long, env = SURVEY_DIR_ENV)]
+    #[arg(long)]
     survey_dir: Option<PathBuf>,
     /// Configuration directory (methods.toml, verdicts.toml, scenarios/).
     #[arg(long)]
@@ -255,7 +261,7 @@ impl Common {
             configs_dir: self.configs.clone().unwrap_or_else(|| root.join("configs")),
             scenarios_dir: self.scenarios.clone(),
             reports_dir: self.reports.clone().unwrap_or_else(|| root.join("reports")),
-            survey_dir: self.survey_dir.clone(),
+            survey_dir: self.survey_dir.clone().or_else(|| path_from_env(SURVEY_DIR_ENV)),
             scenarios,
             methods,
             peers: None,
@@ -283,6 +289,13 @@ pub const EXIT_SLOWER: u8 = 4;
 
 /// Parse `args` (program name first) and run. `Err` means bad input or I/O failure: the caller prints
 /// it and exits with [`EXIT_ERROR`]; argument errors exit inside clap as usual.
+/// The path in environment variable `name`, unless it is unset or empty (`VAR=` in a shell means
+/// "no value", not "the current directory"). Read here rather than by clap, which refuses an empty
+/// value as a missing one.
+fn path_from_env(name: &str) -> Option<PathBuf> {
+    std::env::var_os(name).filter(|v| !v.is_empty()).map(PathBuf::from)
+}
+
 pub fn run<I, T>(args: I) -> anyhow::Result<ExitCode>
 where
     I: IntoIterator<Item = T>,

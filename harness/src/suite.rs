@@ -145,6 +145,15 @@ pub fn prepare(options: &SuiteOptions) -> Result<Prepared, HarnessError> {
             HarnessError::Config { path: catalog.path().to_path_buf(), message: format!("{message}{hint}") }
         })?;
     }
+    if options.reports_dir.exists() && !options.reports_dir.is_dir() {
+        return Err(HarnessError::Config {
+            path: options.reports_dir.clone(),
+            message: "--reports names a file; it must be a directory (or not exist yet)".into(),
+        });
+    }
+    if let Some(sweeps) = &options.sweeps {
+        check_sweep_scenarios(options, &catalog, sweeps)?;
+    }
     let specs = select_specs(options)?;
     for spec in &specs {
         for m in spec.methods.iter().flatten().chain(spec.left_out.keys()) {
@@ -160,6 +169,37 @@ pub fn prepare(options: &SuiteOptions) -> Result<Prepared, HarnessError> {
         skipped.extend(loaded.skipped);
     }
     Ok(Prepared { config: RunConfig { catalog, rules }, scenarios, skipped, source })
+}
+
+/// Every scenario a sweep file's `scenarios` names exists, in the run's scenario directory or the
+/// configuration's `scenarios/`: a misspelt name would otherwise sweep nothing, silently.
+fn check_sweep_scenarios(
+    options: &SuiteOptions,
+    catalog: &MethodCatalog,
+    sweeps: &Path,
+) -> Result<(), HarnessError> {
+    let mut known: Vec<String> = Vec::new();
+    let standard = options.configs_dir.join("scenarios");
+    for dir in options.scenarios_dir.iter().chain([&standard]) {
+        if dir.is_dir() {
+            known.extend(load_specs(dir)?.into_iter().map(|s| s.name));
+        }
+    }
+    for method in catalog.methods() {
+        for name in method.runs_on.iter().flatten() {
+            if !known.contains(name) {
+                return Err(HarnessError::Config {
+                    path: sweeps.to_path_buf(),
+                    message: format!(
+                        "`scenarios` names `{name}` (for `{}`), which is no scenario; known: {}",
+                        method.name,
+                        known.join(", ")
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The methods of a run: `methods.toml` of the configuration directory, and the peers if asked for.

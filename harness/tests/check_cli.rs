@@ -87,3 +87,56 @@ fn check_without_results_or_baseline_is_a_clear_error() {
     assert_eq!(code, 2, "{text}");
     assert!(text.contains("/nonexistent/baseline.json"), "{text}");
 }
+
+/// Issue 38, item 6: mistakes caught before any case runs. A sweep file naming a scenario that does
+/// not exist, and a `--reports` path that is a file, stop the run at once with exit 2 and an error
+/// naming them; an empty `DEFORMBENCH_PYTHON=` counts as unset (no "a value is required").
+#[test]
+fn mistakes_in_the_command_line_and_configs_stop_the_run_before_it_starts() {
+    let dir = tempfile::tempdir().unwrap();
+    let configs = dir.path().join("configs");
+    std::fs::create_dir_all(configs.join("scenarios")).unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().join("configs");
+    for file in ["methods.toml", "verdicts.toml"] {
+        std::fs::copy(root.join(file), configs.join(file)).unwrap();
+    }
+    std::fs::write(
+        configs.join("scenarios/bar.toml"),
+        "name = \"bar\"\nprocedural = { shape = \"bar\", vertices = 600 }\nmethods = [\"isolines\"]\n",
+    )
+    .unwrap();
+    std::fs::write(
+        configs.join("sweeps.toml"),
+        "scenarios = [\"bra\"]\n[per_field]\nmethod = \"isolines\"\nparams = { isolines = [10, 30] }\n",
+    )
+    .unwrap();
+    let reports = dir.path().join("reports");
+    let base = ["all", "--quiet", "--no-check", "--configs", configs.to_str().unwrap()];
+    let with = |extra: &[&str]| {
+        let mut args: Vec<&str> = base.to_vec();
+        args.extend_from_slice(extra);
+        let out = Command::new(env!("CARGO_BIN_EXE_harness"))
+            .args(&args)
+            .env("DEFORMBENCH_PYTHON", "")
+            .env_remove("DEFORM_SURVEY_DIR")
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+        (out.status.code().unwrap_or(-1), text)
+    };
+    let (code, text) = with(&["--sweeps", "--reports", reports.to_str().unwrap()]);
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains("sweeps.toml") && text.contains("`bra`") && text.contains("known: bar"), "{text}");
+    assert!(!reports.exists(), "nothing written");
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, "not a directory").unwrap();
+    let (code, text) = with(&["--reports", file.to_str().unwrap()]);
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains("a-file") && text.contains("--reports names a file"), "{text}");
+    assert!(!text.contains("time by phase"), "no case ran: {text}");
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "not a directory");
+    // The empty DEFORMBENCH_PYTHON of `with` is no value: the run goes on without it.
+    let (code, text) = with(&["--reports", reports.to_str().unwrap()]);
+    assert_eq!(code, 0, "{text}");
+    assert!(reports.join("results.csv").is_file());
+}
