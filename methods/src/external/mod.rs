@@ -264,5 +264,22 @@ impl DeformationMethod for ExternalMethod {
 impl Drop for ExternalMethod {
     fn drop(&mut self) {
         self.process.finish(protocol::encode(&Request::Quit));
+        // A process that left the method's group (setsid, a daemon's double fork) is killed by its
+        // token; that it had escaped is worth a word, and one that survived SIGKILL more so.
+        let escaped = self.process.escaped();
+        if !escaped.killed.is_empty() {
+            eprintln!(
+                "warning: method `{}`: killed {} process(es) it started that had left its process group \
+                 (pids {:?}){}",
+                self.spec.name,
+                escaped.killed.len(),
+                escaped.killed,
+                if escaped.alive.is_empty() {
+                    String::new()
+                } else {
+                    format!("; still running after SIGKILL: {:?}", escaped.alive)
+                }
+            );
+        }
     }
 }

@@ -1,6 +1,9 @@
 //! An external method's process: started in a process group of its own, spoken to line by line
-//! with a timeout per request, its stderr logged and its last lines kept for error messages, and
-//! killed with everything it started when dropped.
+//! with a timeout per request, its stderr logged (its first and last [`STDERR_LOG_KEEP`] bytes) and
+//! its last lines kept for error messages, and killed with everything it started when dropped:
+//! its process group, and every process that carries its [`PROCESS_TOKEN_ENV`], which catches
+//! what left the group or the session (`setsid`, a daemon's double fork) with the environment
+//! inherited.
 //!
 //! Reading and writing go through threads so that a program that stops reading its stdin (a hang, a
 //! crash) can never block the harness: every request waits at most its timeout.
@@ -16,6 +19,16 @@ use std::time::{Duration, Instant};
 
 /// Lines of stderr kept for error messages.
 pub const STDERR_TAIL_LINES: usize = 8;
+
+/// Of a method's stderr the log keeps this many bytes from the start and as many from the end,
+/// with a line saying how much was cut between them: a chatty method cannot fill the disk over a
+/// large run.
+pub const STDERR_LOG_KEEP: usize = 1 << 20;
+
+/// The environment variable every method process gets, unique to that process (harness pid and a
+/// counter); whatever it starts inherits it, so the descendants can be found after they left the
+/// process group.
+pub const PROCESS_TOKEN_ENV: &str = "DEFORMBENCH_PROCESS_TOKEN";
 
 /// How long a program may take to exit after `quit` before it is killed.
 const EXIT_GRACE: Duration = Duration::from_secs(2);
@@ -56,6 +69,19 @@ pub struct MethodProcess {
     /// Signalled when the stderr reader has seen end of file (so the log is complete).
     stderr_done: Receiver<()>,
     killed: bool,
+    /// [`PROCESS_TOKEN_ENV`]'s value for this process.
+    token: String,
+    /// Processes outside its group killed by the token when it ended, and those still alive after.
+    escaped: Escaped,
+}
+
+/// What [`MethodProcess::kill`] found outside the program's process group.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Escaped {
+    /// Processes that carried the program's token after its group was killed: killed.
+    pub killed: Vec<u32>,
+    /// Of those, the ones still running (not even a zombie) after the kill.
+    pub alive: Vec<u32>,
 }
 
 /// The last [`STDERR_TAIL_LINES`] lines of stderr.
@@ -82,6 +108,10 @@ impl MethodProcess {
             command.current_dir(dir);
         }
         command.envs(env.iter().map(|(k, v)| (k, v)));
+        static STARTED: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let token =
+            format!("{}-{}", std::process::id(), STARTED.fetch_add(1, std::sync::atomic::Ordering::Relaxed));
+        command.env(PROCESS_TOKEN_ENV, &token);
         let mut child = command.spawn().map_err(ProcessFault::Start)?;
         let stdin = child.stdin.take().expect("piped");
         let stdout = child.stdout.take().expect("piped");
@@ -121,6 +151,8 @@ impl MethodProcess {
             stderr: tail,
             stderr_done,
             killed: false,
+            token,
+            escaped: Escaped::default(),
         })
     }
 
@@ -146,8 +178,8 @@ impl MethodProcess {
         self.stderr.lock().map(|t| t.lines.iter().cloned().collect()).unwrap_or_default()
     }
 
-    /// Kill the program and everything in its process group, reap it, and let the stderr reader
-    /// finish the log (briefly: a process outside the group may hold the pipe).
+    /// Kill the program and everything in its process group, then every process that still
+    /// carries its token (it left the group), reap it, and let the stderr reader finish the log.
     pub fn kill(&mut self) {
         if self.killed {
             return;
@@ -156,6 +188,7 @@ impl MethodProcess {
         kill_group(self.child.id());
         let _ = self.child.wait();
         self.killed = true;
+        self.escaped = kill_carriers(&self.token);
         let _ = self.stderr_done.recv_timeout(Duration::from_millis(500));
     }
 
@@ -177,6 +210,11 @@ impl MethodProcess {
         }
         // Also ends any child the program left behind in its group.
         self.kill();
+    }
+
+    /// What the kill found outside the program's process group (empty before it ended).
+    pub fn escaped(&self) -> &Escaped {
+        &self.escaped
     }
 
     /// The exit status once the program has ended (waits up to a second for it to end).
@@ -206,6 +244,50 @@ fn kill_group(pgid: u32) {
     }
 }
 
+/// The processes whose environment holds `PROCESS_TOKEN_ENV=token`, other than this one.
+fn carriers(token: &str) -> Vec<u32> {
+    let needle = format!("{PROCESS_TOKEN_ENV}={token}\0");
+    let me = std::process::id();
+    let Ok(entries) = std::fs::read_dir("/proc") else { return Vec::new() };
+    let mut out: Vec<u32> = entries
+        .filter_map(|e| e.ok()?.file_name().to_str()?.parse::<u32>().ok())
+        .filter(|&pid| pid != me)
+        .filter(|pid| {
+            std::fs::read(format!("/proc/{pid}/environ"))
+                .is_ok_and(|env| env.windows(needle.len()).any(|w| w == needle.as_bytes()))
+        })
+        .collect();
+    out.sort_unstable();
+    out
+}
+
+/// Whether `pid` runs (exists and is not a zombie).
+fn running(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .is_ok_and(|stat| stat.rsplit(')').next().is_some_and(|rest| !rest.trim_start().starts_with('Z')))
+}
+
+/// SIGKILL every process carrying `token` (they left the program's group), then which still run.
+fn kill_carriers(token: &str) -> Escaped {
+    let found: Vec<u32> = carriers(token).into_iter().filter(|&pid| running(pid)).collect();
+    if found.is_empty() {
+        return Escaped::default();
+    }
+    for &pid in &found {
+        // SAFETY: kill(2) on a pid; no memory is shared.
+        unsafe {
+            libc::kill(pid as libc::pid_t, libc::SIGKILL);
+        }
+    }
+    let deadline = Instant::now() + Duration::from_millis(500);
+    let mut alive = found.clone();
+    while !alive.is_empty() && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(10));
+        alive.retain(|&pid| running(pid));
+    }
+    Escaped { killed: found, alive }
+}
+
 fn write_lines(mut stdin: ChildStdin, lines: Receiver<String>) {
     for line in lines {
         if stdin.write_all(line.as_bytes()).and_then(|()| stdin.flush()).is_err() {
@@ -231,16 +313,22 @@ fn read_lines(stdout: impl Read, answers: Sender<Result<Option<String>, std::io:
     }
 }
 
-fn keep_stderr(stderr: impl Read, mut log: Option<std::fs::File>, tail: &Mutex<StderrTail>) {
+fn keep_stderr(stderr: impl Read, log: Option<std::fs::File>, tail: &Mutex<StderrTail>) {
     let mut reader = BufReader::new(stderr);
+    let mut log = log.map(CappedLog::new);
     let mut bytes = Vec::new();
     loop {
         bytes.clear();
         match reader.read_until(b'\n', &mut bytes) {
-            Ok(0) | Err(_) => return,
+            Ok(0) | Err(_) => {
+                if let Some(log) = log.take() {
+                    log.close();
+                }
+                return;
+            }
             Ok(_) => {
-                if let Some(file) = &mut log {
-                    let _ = file.write_all(&bytes);
+                if let Some(log) = &mut log {
+                    log.write(&bytes);
                 }
                 let line = String::from_utf8_lossy(&bytes).trim_end().to_string();
                 if let Ok(mut tail) = tail.lock() {
@@ -251,5 +339,106 @@ fn keep_stderr(stderr: impl Read, mut log: Option<std::fs::File>, tail: &Mutex<S
                 }
             }
         }
+    }
+}
+
+/// A stderr log that keeps the first and the last [`STDERR_LOG_KEEP`] bytes: the head is written
+/// as it comes, the tail held until the stream ends, with a line saying how much was cut.
+struct CappedLog {
+    file: std::fs::File,
+    head: usize,
+    tail: VecDeque<u8>,
+    cut: u64,
+}
+
+impl CappedLog {
+    fn new(file: std::fs::File) -> Self {
+        CappedLog { file, head: 0, tail: VecDeque::new(), cut: 0 }
+    }
+
+    fn write(&mut self, mut bytes: &[u8]) {
+        if self.head < STDERR_LOG_KEEP {
+            let n = bytes.len().min(STDERR_LOG_KEEP - self.head);
+            let _ = self.file.write_all(&bytes[..n]);
+            self.head += n;
+            bytes = &bytes[n..];
+        }
+        self.tail.extend(bytes);
+        let over = self.tail.len().saturating_sub(STDERR_LOG_KEEP);
+        if over > 0 {
+            self.tail.drain(..over);
+            self.cut += over as u64;
+        }
+    }
+
+    fn close(mut self) {
+        if self.cut > 0 {
+            let _ = writeln!(
+                self.file,
+                "\n[deformbench: {} bytes of stderr cut here; the log keeps the first and the last {} bytes]",
+                self.cut, STDERR_LOG_KEEP
+            );
+        }
+        let (a, b) = self.tail.as_slices();
+        let _ = self.file.write_all(a).and_then(|()| self.file.write_all(b));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_long_log_keeps_its_head_and_tail_and_says_what_was_cut() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("log");
+        let mut log = CappedLog::new(std::fs::File::create(&path).unwrap());
+        let line = |i: usize| format!("line {i:08}\n");
+        let n = 3 * STDERR_LOG_KEEP / line(0).len();
+        for i in 0..n {
+            log.write(line(i).as_bytes());
+        }
+        log.close();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.starts_with(&line(0)));
+        assert!(text.ends_with(&line(n - 1)));
+        let cut = n * line(0).len() - 2 * STDERR_LOG_KEEP;
+        assert!(
+            text.contains(&format!("[deformbench: {cut} bytes of stderr cut here")),
+            "{}",
+            &text[STDERR_LOG_KEEP - 40..STDERR_LOG_KEEP + 120]
+        );
+        assert!(text.len() < 2 * STDERR_LOG_KEEP + 200);
+    }
+
+    #[test]
+    fn a_short_log_is_kept_whole() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("log");
+        let mut log = CappedLog::new(std::fs::File::create(&path).unwrap());
+        log.write(b"one\n");
+        log.write(b"two\n");
+        log.close();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "one\ntwo\n");
+    }
+
+    /// A program that double-forks a sleeper into a session of its own (as a daemon does) leaves
+    /// nothing running once it is killed: the sleeper left the group but carries the token.
+    #[test]
+    fn a_child_that_left_the_session_is_killed_with_its_program() {
+        let script = "setsid sh -c 'sleep 300' & sleep 300";
+        let mut p = MethodProcess::start("sh", &["-c".into(), script.into()], None, &[], None).unwrap();
+        let token = p.token.clone();
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while carriers(&token).len() < 3 && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let before = carriers(&token);
+        assert!(before.len() >= 3, "sh, its sleep and the setsid one: {before:?}");
+        p.kill();
+        let after: Vec<u32> = carriers(&token).into_iter().filter(|&pid| running(pid)).collect();
+        assert!(after.is_empty(), "still running: {after:?}");
+        assert!(!p.escaped().killed.is_empty(), "the escaped sleeper was found: {:?}", p.escaped());
+        assert!(p.escaped().alive.is_empty());
     }
 }
