@@ -208,6 +208,10 @@ struct Common {
     /// Configuration directory (methods.toml, verdicts.toml, scenarios/).
     #[arg(long)]
     configs: Option<PathBuf>,
+    /// A method file of your own, in the methods.toml format (paths relative to it), added on top
+    /// of the configuration's methods; repeatable [env: DEFORMBENCH_METHODS=a.toml:b.toml].
+    #[arg(long = "methods", value_name = "FILE")]
+    method_files: Vec<PathBuf>,
     /// Scenario directory [default: scenarios/ in the configuration directory]; e.g.
     /// configs/real-meshes for the real-mesh suite.
     #[arg(long)]
@@ -266,6 +270,14 @@ impl Common {
             methods,
             peers: None,
             sweeps: None,
+            method_files: if self.method_files.is_empty() {
+                std::env::var_os(METHODS_ENV)
+                    .map(|v| std::env::split_paths(&v).filter(|p| !p.as_os_str().is_empty()).collect())
+                    .unwrap_or_default()
+            } else {
+                self.method_files.clone()
+            },
+            python: path_from_env(peers::PYTHON_ENV),
             threads: self
                 .threads
                 .map_or_else(|| crate::threads::default_threads(self.jobs as usize), |t| t as usize),
@@ -289,6 +301,9 @@ pub const EXIT_SLOWER: u8 = 4;
 
 /// Parse `args` (program name first) and run. `Err` means bad input or I/O failure: the caller prints
 /// it and exits with [`EXIT_ERROR`]; argument errors exit inside clap as usual.
+/// Method files added by default when `--methods` is not given, separated by `:`.
+pub const METHODS_ENV: &str = "DEFORMBENCH_METHODS";
+
 /// The path in environment variable `name`, unless it is unset or empty (`VAR=` in a shell means
 /// "no value", not "the current directory"). Read here rather than by clap, which refuses an empty
 /// value as a missing one.
@@ -307,6 +322,7 @@ where
     match cli.command {
         Command::All { common, peers, meshes, gate, no_check, shard } => {
             let mut options = common.options(Vec::new(), Vec::new(), &command_line);
+            options.python = peers.python_path();
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
             if let Some(shard) = shard {
@@ -332,6 +348,7 @@ where
         }
         Command::Run { methods, scenario, common, peers, meshes } => {
             let mut options = common.options(vec![scenario], methods, &command_line);
+            options.python = peers.python_path();
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
             let publish = PublishOptions { peer_python: peers.python()?, meshes: meshes.output() };
@@ -391,7 +408,12 @@ where
                 } else {
                     format!("[{}] ", m.origin.label())
                 };
-                println!("  {:<14} {origin}{}", m.name, m.summary);
+                match &m.unavailable {
+                    None => println!("  {:<14} {origin}{}", m.name, m.summary),
+                    Some(why) => {
+                        println!("  {:<14} {origin}UNAVAILABLE: {why} ({})", m.name, m.file.display())
+                    }
+                }
             }
             println!("scenarios ({}):", options.configs_dir.join("scenarios").display());
             for s in load_specs(&options.configs_dir.join("scenarios"))? {

@@ -101,6 +101,12 @@ pub struct ConfiguredMethod {
     /// The scenarios it runs on unless a scenario names it (`None`: every scenario that does not
     /// restrict its methods); a sweep file's `scenarios`.
     pub runs_on: Option<Vec<String>>,
+    /// The file its entry is in (empty for a built-in method without a table).
+    pub file: PathBuf,
+    /// Why it cannot run on this machine, when it cannot: an external entry whose environment
+    /// variable is unset, whose working directory or program is missing. It disables itself: a run
+    /// that asks for it by name fails with the reason, any other run goes on without it.
+    pub unavailable: Option<String>,
 }
 
 impl ConfiguredMethod {
@@ -111,6 +117,12 @@ impl ConfiguredMethod {
         stderr_log: Option<PathBuf>,
         threads: usize,
     ) -> Result<Box<dyn DeformationMethod>, MethodError> {
+        if let Some(why) = &self.unavailable {
+            return Err(MethodError::External {
+                method: self.name.clone(),
+                message: format!("unavailable: {why}"),
+            });
+        }
         match &self.implementation {
             Implementation::BuiltIn(entry) => (entry.create)(&self.params),
             Implementation::External(e) => Ok(Box::new(ExternalMethod::start(ExternalSpec {
@@ -145,6 +157,12 @@ impl MethodCatalog {
     /// parameters it accepts, a variant of one (`method`, `params`), or an external method with a
     /// `command`.
     pub fn load(path: &Path) -> Result<Self, HarnessError> {
+        Self::load_with(path, &[])
+    }
+
+    /// [`MethodCatalog::load`] with `given` variables expanded before the environment's
+    /// (`--python` as `${DEFORMBENCH_PYTHON}`).
+    pub fn load_with(path: &Path, given: &[(&str, &str)]) -> Result<Self, HarnessError> {
         let mut methods: Vec<ConfiguredMethod> = methods::registry::METHODS
             .iter()
             .map(|m| ConfiguredMethod {
@@ -155,6 +173,8 @@ impl MethodCatalog {
                 summary: m.summary.to_string(),
                 sweeps: Vec::new(),
                 runs_on: None,
+                file: PathBuf::new(),
+                unavailable: None,
             })
             .collect();
         let tables = read_tables(path)?;
@@ -166,6 +186,7 @@ impl MethodCatalog {
             methods::registry::create(name, table).map_err(|e| config(e.to_string()))?;
             let entry = methods.iter_mut().find(|m| &m.name == name).expect("a registered method");
             entry.params = table.clone();
+            entry.file = path.to_path_buf();
         }
         let mut catalog = Self { path: path.to_path_buf(), methods };
         for (name, table) in tables.iter().filter(|(_, t)| is_entry(t)) {
@@ -175,9 +196,34 @@ impl MethodCatalog {
                     message: format!("`{name}` is a built-in method; a new entry needs another name"),
                 });
             }
-            catalog.add_entry(path, name, table, Origin::External, &[], None)?;
+            catalog.add_entry(path, name, table, Origin::External, given, None)?;
         }
         Ok(catalog)
+    }
+
+    /// Add the entries of a method file of the user's (`--methods FILE`): external methods and
+    /// variants in the `methods.toml` format, paths relative to `path`, `given` variables expanded
+    /// before the environment's. A name another file already gives is an error naming both.
+    pub fn add_method_file(&mut self, path: &Path, given: &[(&str, &str)]) -> Result<(), HarnessError> {
+        for (name, table) in read_tables(path)? {
+            let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
+            if let Some(other) = self.get(&name) {
+                let where_ = if other.file.as_os_str().is_empty() {
+                    "a built-in method".to_string()
+                } else {
+                    format!("already an entry of {}", other.file.display())
+                };
+                return Err(config(format!("[{name}]: `{name}` is {where_}; give this one another name")));
+            }
+            if !table.contains_key("command") && !table.contains_key("method") {
+                return Err(config(format!(
+                    "[{name}]: an entry of a method file is an external program (`command`) or a variant \
+                     (`method = \"arap\"` and its `params`)"
+                )));
+            }
+            self.add_entry(path, &name, &table, Origin::External, given, None)?;
+        }
+        Ok(())
     }
 
     /// Add the sweeps of `path` (`configs/sweeps.toml`, `--sweeps`): variants with list-valued
@@ -323,6 +369,8 @@ impl MethodCatalog {
                 },
                 sweeps: vec![here],
                 runs_on: runs_on.map(<[String]>::to_vec),
+                file: path.to_path_buf(),
+                unavailable: base.unavailable.clone(),
             });
         }
         Ok(())
@@ -432,6 +480,8 @@ fn entry(
             implementation: Implementation::BuiltIn(builtin),
             sweeps: Vec::new(),
             runs_on: None,
+            file: path.to_path_buf(),
+            unavailable: None,
         });
     }
     if let Some(key) = table.keys().find(|k| !EXTERNAL_KEYS.contains(&k.as_str())) {
@@ -452,28 +502,41 @@ fn entry(
             ))
         }
     };
-    let command = command
+    // What the machine lacks (a variable, a directory, a program) disables the entry, not the run.
+    let mut unavailable: Option<String> = None;
+    let command: Vec<String> = command
         .iter()
-        .map(|part| crate::variables::expand_with(part, "the command of an external method", given))
-        .collect::<Result<Vec<String>, String>>()
-        .map_err(config)?;
+        .map(|part| {
+            crate::variables::expand_with(part, "the command of an external method", given).unwrap_or_else(
+                |why| {
+                    unavailable.get_or_insert(why);
+                    part.clone()
+                },
+            )
+        })
+        .collect();
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let working_dir = match table.get("working_dir") {
         None => base.clone(),
-        Some(toml::Value::String(dir)) => {
-            let dir = PathBuf::from(crate::variables::expand(dir, "working_dir").map_err(config)?);
-            if dir.is_absolute() {
-                dir
-            } else {
-                base.join(dir)
+        Some(toml::Value::String(dir)) => match crate::variables::expand(dir, "working_dir") {
+            Ok(expanded) if Path::new(&expanded).is_absolute() => PathBuf::from(expanded),
+            Ok(expanded) => base.join(expanded),
+            Err(why) => {
+                unavailable.get_or_insert(why);
+                base.clone()
             }
-        }
+        },
         Some(_) => return Err(config("`working_dir` must be a string".into())),
     };
-    if !working_dir.is_dir() {
-        return Err(config(format!("working_dir {} is not a directory", working_dir.display())));
+    if unavailable.is_none() && !working_dir.is_dir() {
+        unavailable = Some(format!("its working_dir {} is not a directory", working_dir.display()));
     }
     let working_dir = working_dir.canonicalize().unwrap_or(working_dir);
+    if unavailable.is_none() {
+        if let Err(why) = program_found(&command[0], &working_dir) {
+            unavailable = Some(why);
+        }
+    }
     let timeout = match table.get("timeout_s") {
         None => methods::external::DEFAULT_TIMEOUT,
         Some(v) => match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
@@ -491,6 +554,8 @@ fn entry(
         summary,
         sweeps: Vec::new(),
         runs_on: None,
+        file: path.to_path_buf(),
+        unavailable,
         implementation: Implementation::External(ExternalEntry {
             program: command.next().expect("non-empty"),
             args: command.collect(),
@@ -499,6 +564,26 @@ fn entry(
             params: json,
         }),
     })
+}
+
+/// Whether `program` can be started from `working_dir`: a path (with a `/`) names a file there or
+/// anywhere; a bare name is looked up on `PATH`. `Err` says what is missing.
+fn program_found(program: &str, working_dir: &Path) -> Result<(), String> {
+    if program.contains('/') {
+        let file = working_dir.join(program);
+        return if file.is_file() {
+            Ok(())
+        } else {
+            Err(format!("its program {} does not exist", file.display()))
+        };
+    }
+    let on_path = std::env::var_os("PATH")
+        .is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()));
+    if on_path {
+        Ok(())
+    } else {
+        Err(format!("its program `{program}` is not on PATH"))
+    }
 }
 
 #[cfg(test)]

@@ -49,6 +49,11 @@ pub struct SuiteOptions {
     pub peers: Option<PeerSetup>,
     /// Add the parameter sweeps of this file (`configs/sweeps.toml`, `--sweeps`).
     pub sweeps: Option<PathBuf>,
+    /// Method files of the user's, added on top of `methods.toml` (`--methods`,
+    /// `DEFORMBENCH_METHODS`).
+    pub method_files: Vec<PathBuf>,
+    /// `${DEFORMBENCH_PYTHON}` in every method file's commands (`--python`, else the environment).
+    pub python: Option<PathBuf>,
     /// Worker threads of every method ([`crate::threads`]).
     pub threads: usize,
     /// Cases run at a time, each in its own pool of `threads` workers (`--jobs`).
@@ -74,6 +79,16 @@ pub struct SuiteRun {
 }
 
 impl SuiteRun {
+    /// With a note per method of `catalog` that could not run here and why (once per run).
+    fn with_unavailable(mut self, catalog: &MethodCatalog) -> SuiteRun {
+        self.notes.extend(catalog.methods().iter().filter_map(|m| {
+            m.unavailable
+                .as_ref()
+                .map(|why| format!("method `{m}` ({}) skipped: {why}", m.file.display(), m = m.name))
+        }));
+        self
+    }
+
     /// The run of `results` on `scenarios`, its notes gathered ([`notes_of`]).
     fn new(
         options: &SuiteOptions,
@@ -138,6 +153,12 @@ pub fn prepare(options: &SuiteOptions) -> Result<Prepared, HarnessError> {
     let catalog = load_catalog(options)?;
     let rules = VerdictRules::load(&options.configs_dir.join("verdicts.toml"))?;
     for m in &options.methods {
+        if let Some(why) = catalog.get(m).and_then(|c| c.unavailable.as_ref().map(|w| (c, w))) {
+            return Err(HarnessError::Config {
+                path: why.0.file.clone(),
+                message: format!("[{m}]: cannot run here: {}", why.1),
+            });
+        }
         catalog.find(m).map_err(|message| {
             let peers = options.configs_dir.join("peers.toml");
             let is_peer = std::fs::read_to_string(&peers).is_ok_and(|t| t.contains(&format!("[{m}]")));
@@ -204,7 +225,12 @@ fn check_sweep_scenarios(
 
 /// The methods of a run: `methods.toml` of the configuration directory, and the peers if asked for.
 pub fn load_catalog(options: &SuiteOptions) -> Result<MethodCatalog, HarnessError> {
-    let mut catalog = MethodCatalog::load(&options.configs_dir.join("methods.toml"))?;
+    let python = options.python.as_ref().map(|p| p.to_string_lossy().into_owned());
+    let given: Vec<(&str, &str)> = python.iter().map(|p| (crate::peers::PYTHON_ENV, p.as_str())).collect();
+    let mut catalog = MethodCatalog::load_with(&options.configs_dir.join("methods.toml"), &given)?;
+    for file in &options.method_files {
+        catalog.add_method_file(file, &given)?;
+    }
     if let Some(peers) = &options.peers {
         catalog.add_peers(peers)?;
     }
@@ -262,7 +288,7 @@ fn plan(options: &SuiteOptions, catalog: &MethodCatalog, scenarios: &[LoadedScen
                     Some(list) => list.contains(&m.name),
                     None => m.runs_on.as_ref().is_none_or(|on| on.contains(name)),
                 })
-                .filter(|m| !s.spec.left_out.contains_key(&m.name))
+                .filter(|m| !s.spec.left_out.contains_key(&m.name) && m.unavailable.is_none())
                 .map(|m| m.name.as_str())
                 .filter(|m| options.methods.is_empty() || options.methods.iter().any(|x| x == m))
                 .map(str::to_string)
@@ -281,7 +307,8 @@ pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
     let results = run_plan(options, &config, &scenarios, &plan)?;
     provenance.external = crate::provenance::external_records(&results);
     let data_source = describe_data(&source, &scenarios);
-    Ok(SuiteRun::new(options, results, scenarios, skipped, data_source, provenance))
+    Ok(SuiteRun::new(options, results, scenarios, skipped, data_source, provenance)
+        .with_unavailable(&config.catalog))
 }
 
 /// Run the scenarios of part `shard` of the suite ([`crate::shard::assign`] on their estimated cost).
@@ -307,7 +334,8 @@ pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, Harne
     let scenarios: Vec<LoadedScenario> = mine.into_iter().map(|(s, _)| s).collect();
     let results = run_plan(options, &config, &scenarios, &plan)?;
     provenance.external = crate::provenance::external_records(&results);
-    Ok(SuiteRun::new(options, results, scenarios, skipped, data_source, provenance))
+    Ok(SuiteRun::new(options, results, scenarios, skipped, data_source, provenance)
+        .with_unavailable(&config.catalog))
 }
 
 /// The record of a run started now with `options`.
@@ -594,7 +622,8 @@ pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, Harne
     }
     results.sort_by_key(|(i, order, _)| (*i, *order));
     let results: Vec<CaseResult> = results.into_iter().map(|(_, _, c)| c).collect();
-    Ok(SuiteRun::new(options, results, scenarios, skipped, data_source, provenance))
+    Ok(SuiteRun::new(options, results, scenarios, skipped, data_source, provenance)
+        .with_unavailable(&config.catalog))
 }
 
 /// One line on where the meshes of `scenarios` came from.

@@ -140,3 +140,94 @@ fn mistakes_in_the_command_line_and_configs_stop_the_run_before_it_starts() {
     assert_eq!(code, 0, "{text}");
     assert!(reports.join("results.csv").is_file());
 }
+
+/// Issue 38, item 2: an entry this machine cannot run disables itself. Beside working built-in
+/// rows, an entry with an unset variable, one with a missing working directory and one whose
+/// program does not exist: `list` names each with its reason, a run that does not ask for them
+/// runs the others and notes them once, a run that asks for one by name fails (exit 2) with its
+/// reason. A malformed entry stays an error naming file, entry and key; a name given twice names
+/// both files.
+#[test]
+fn an_entry_that_cannot_run_here_disables_itself_and_the_others_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("mine.toml");
+    std::fs::write(
+        &file,
+        "[needs_var]\ncommand = [\"${DEFORMBENCH_SURELY_UNSET_VARIABLE}\", \"m.py\"]\n\
+         [no_dir]\ncommand = [\"python3\", \"m.py\"]\nworking_dir = \"nowhere\"\n\
+         [no_program]\ncommand = [\"./no-such-program\"]\n",
+    )
+    .unwrap();
+    let configs = dir.path().join("configs");
+    std::fs::create_dir_all(configs.join("scenarios")).unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().join("configs");
+    for file in ["methods.toml", "verdicts.toml"] {
+        std::fs::copy(root.join(file), configs.join(file)).unwrap();
+    }
+    std::fs::write(
+        configs.join("scenarios/bar.toml"),
+        "name = \"bar\"\nprocedural = { shape = \"bar\", vertices = 600 }\nmethods = [\"arap\", \"isolines\"]\n",
+    )
+    .unwrap();
+    let harness = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_harness"))
+            .args(args)
+            .args(["--configs", configs.to_str().unwrap(), "--methods", file.to_str().unwrap()])
+            .env_remove("DEFORMBENCH_SURELY_UNSET_VARIABLE")
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+        (out.status.code().unwrap_or(-1), text)
+    };
+    let (code, text) = harness(&["list"]);
+    assert_eq!(code, 0, "{text}");
+    for (name, why) in [
+        ("needs_var", "DEFORMBENCH_SURELY_UNSET_VARIABLE"),
+        ("no_dir", "nowhere is not a directory"),
+        ("no_program", "no-such-program does not exist"),
+    ] {
+        let line =
+            text.lines().find(|l| l.trim_start().starts_with(name)).unwrap_or_else(|| panic!("{text}"));
+        assert!(line.contains("UNAVAILABLE") && line.contains(why), "{line}");
+    }
+    let reports = dir.path().join("reports");
+    let (code, text) = harness(&["all", "--quiet", "--no-check", "--reports", reports.to_str().unwrap()]);
+    assert_eq!(code, 0, "{text}");
+    assert_eq!(text.matches("method `no_dir`").count(), 1, "said once: {text}");
+    let csv = std::fs::read_to_string(reports.join("results.csv")).unwrap();
+    assert!(csv.contains("\nbar,arap,") && csv.contains("\nbar,isolines,") && !csv.contains(",no_"), "{csv}");
+    let (code, text) = harness(&[
+        "run",
+        "--scenario",
+        "bar",
+        "--method",
+        "no_program",
+        "--reports",
+        reports.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{text}");
+    assert!(
+        text.contains("mine.toml") && text.contains("[no_program]") && text.contains("does not exist"),
+        "{text}"
+    );
+
+    std::fs::write(&file, "[bad]\ncommand = [\"python3\"]\ntimeout = 3\n").unwrap();
+    let (code, text) = harness(&["list"]);
+    assert_eq!(code, 2, "{text}");
+    assert!(
+        text.contains("mine.toml") && text.contains("[bad]") && text.contains("unknown key `timeout`"),
+        "{text}"
+    );
+    std::fs::write(&file, "[arap_cotan]\nmethod = \"arap\"\n[laplacian_too]\nmethod = \"laplacian\"\n")
+        .unwrap();
+    let (code, text) = harness(&["list"]);
+    assert_eq!(code, 0, "arap_cotan is a peer, not in methods.toml: {text}");
+    std::fs::write(&file, "[arap]\ncommand = [\"python3\"]\n").unwrap();
+    let (code, text) = harness(&["list"]);
+    assert_eq!(code, 2, "{text}");
+    assert!(
+        text.contains("mine.toml: [arap]: `arap` is already an entry of")
+            && text.contains("configs/methods.toml"),
+        "{text}"
+    );
+}
