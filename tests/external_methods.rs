@@ -136,7 +136,9 @@ fn a_broken_method_beside_built_in_ones_fails_alone_and_leaves_nothing_running()
         "[toy_crash]\ncommand = [\"python3\", \"{toy}\", \"crash-in-solve\"]\n\n\
          [toy_hang]\ncommand = [\"python3\", \"{toy}\", \"hang\", \"{pid}\"]\ntimeout_s = 5\n\n\
          [toy_nan]\ncommand = [\"python3\", \"{toy}\", \"nan\"]\n\n\
-         [toy_ok]\ncommand = [\"python3\", \"{toy}\", \"ok\"]\n",
+         [toy_ok]\ncommand = [\"python3\", \"{toy}\", \"ok\"]\n\n\
+         [toy_silent]\ncommand = [\"python3\", \"{toy}\", \"silent\"]\nkind = \"iterative\"\n\n\
+         [toy_direct]\ncommand = [\"python3\", \"{toy}\", \"silent\"]\nkind = \"direct\"\n",
         toy = toy.display(),
         pid = pid_file.display()
     );
@@ -144,7 +146,9 @@ fn a_broken_method_beside_built_in_ones_fails_alone_and_leaves_nothing_running()
         format!("name = \"bar\"\nprocedural = {{ shape = \"bar\", vertices = 800 }}\nmethods = [{methods}]\n")
     };
     let built_in = "\"laplacian\", \"arap\", \"isolines\"";
-    let with_toys = format!("{built_in}, \"toy_crash\", \"toy_hang\", \"toy_nan\", \"toy_ok\"");
+    let with_toys = format!(
+        "{built_in}, \"toy_crash\", \"toy_hang\", \"toy_nan\", \"toy_ok\", \"toy_silent\", \"toy_direct\""
+    );
     let broken = configs_in(&dir.path().join("broken"), &[("bar.toml", scenario(&with_toys))], &toys);
     let plain = configs_in(&dir.path().join("plain"), &[("bar.toml", scenario(built_in))], "");
     let all = |configs: &Path, reports: &str| {
@@ -180,6 +184,12 @@ fn a_broken_method_beside_built_in_ones_fails_alone_and_leaves_nothing_running()
     }
     // The well-behaved toy moves only its handles; the verdict sees the tear like any method's.
     assert!(status("toy_ok").starts_with("suspect: folds"), "{}", status("toy_ok"));
+    // An iterative method that says nothing of its convergence is not silently finished (issue 38);
+    // the same answers from a direct method are.
+    assert!(status("toy_silent").contains("convergence unknown"), "{}", status("toy_silent"));
+    assert_eq!(row(&rows, "toy_silent")["converged"], "unknown");
+    assert!(!status("toy_direct").contains("convergence unknown"), "{}", status("toy_direct"));
+    assert_eq!(row(&rows, "toy_direct")["converged"], "true");
     assert_eq!(row(&rows, "toy_ok")["origin"], "external");
 
     // The built-in rows are those of a run without the toys, to the last bit.

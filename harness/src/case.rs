@@ -77,6 +77,10 @@ pub struct StepRecord {
     pub phase_timings: Vec<(String, f64)>,
 }
 
+/// The reason a case of an iterative method that did not report its convergence is `suspect`.
+pub const CONVERGENCE_UNKNOWN: &str =
+    "convergence unknown: an iterative method that did not say whether its solve converged";
+
 /// Measurements of one case. Times are wall-clock seconds; the `*_over_diag` values are relative to
 /// the rest bounding-box diagonal; the quality measures are those of [`crate::metrics::METRICS`].
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -126,6 +130,10 @@ pub struct CaseResult {
     #[serde(default = "nan", deserialize_with = "nan_from_null")]
     pub peak_memory_mib: f64,
     pub converged: bool,
+    /// An iterative method that did not say whether it converged (external `kind = "iterative"`):
+    /// `converged` is then only "finished", and the case is `suspect: convergence unknown`.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub convergence_unknown: bool,
     /// Every measure of the metric table, one JSON field per metric key (`null`: none).
     #[serde(flatten)]
     pub quality: Quality,
@@ -469,6 +477,7 @@ pub fn run_case(
             let step_solve_s = t.elapsed().as_secs_f64() - (recorder.quality_s - quality_before);
             solve_s += step_solve_s;
             result.iterations += summary.iterations;
+            result.convergence_unknown |= summary.convergence_unknown;
             if !summary.converged {
                 unfinished.push(Unfinished {
                     step: i + 1,
@@ -531,7 +540,10 @@ pub fn run_case(
             asked_scale: asked_scale(scenario.mesh.positions(), &step.handles, &targets),
             reference_finished,
         };
-        let reasons = rules.reasons(&result.quality, motion);
+        let mut reasons = rules.reasons(&result.quality, motion);
+        if result.convergence_unknown {
+            reasons.push(CONVERGENCE_UNKNOWN.to_string());
+        }
         result.positions = Some(positions);
         result.overhead.evaluation_s = evaluation_start.elapsed().as_secs_f64();
         Ok(reasons)
@@ -649,6 +661,7 @@ impl CaseResult {
             total_s: f64::NAN,
             peak_memory_mib: f64::NAN,
             converged: false,
+            convergence_unknown: false,
             quality: Quality::default(),
             largest_move_over_diag: f64::NAN,
             largest_handle_move_over_diag: f64::NAN,

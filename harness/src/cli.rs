@@ -118,6 +118,18 @@ enum Command {
     },
     /// List the registered methods and the scenarios.
     List(Common),
+    /// Run the whole method protocol once on a tiny built-in mesh (hello, precompute, two binds
+    /// and solves, quit) and say what is wrong in plain words, with the times (docs/protocol.md);
+    /// exit 0 when the method speaks the protocol. With --methods FILE for your own method.
+    CheckMethod {
+        /// The method's name (see `list`).
+        name: String,
+        #[command(flatten)]
+        common: Common,
+        /// The Python for `${DEFORMBENCH_PYTHON}` [env: DEFORMBENCH_PYTHON].
+        #[arg(long)]
+        python: Option<PathBuf>,
+    },
 }
 
 /// What makes `compare` exit non-zero.
@@ -397,6 +409,32 @@ where
                 return Ok(ExitCode::from(EXIT_SLOWER));
             }
             Ok(ExitCode::SUCCESS)
+        }
+        Command::CheckMethod { name, common, python } => {
+            let mut options = common.options(Vec::new(), Vec::new(), &command_line);
+            if python.is_some() {
+                options.python = python;
+            }
+            let catalog = suite::load_catalog(&options)?;
+            let method = catalog.find(&name).map_err(|m| anyhow::anyhow!("{m}"))?;
+            println!(
+                "checking `{name}` ({}) on a {}-vertex bar:",
+                method.summary,
+                crate::method_check::CHECK_VERTICES
+            );
+            let result = crate::method_check::check(method);
+            for line in &result.lines {
+                println!("  {line}");
+            }
+            if result.passed {
+                println!("`{name}` speaks the protocol");
+                Ok(ExitCode::SUCCESS)
+            } else {
+                println!(
+                    "`{name}` does not speak the protocol yet: see the FAIL line above and docs/protocol.md"
+                );
+                Ok(ExitCode::from(EXIT_CASE_FAILED))
+            }
         }
         Command::List(common) => {
             let options = common.options(Vec::new(), Vec::new(), &command_line);

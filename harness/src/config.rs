@@ -42,7 +42,7 @@ impl Origin {
 
 /// The keys of an external method's table; everything else is an error (its own parameters go in
 /// its `params` table).
-const EXTERNAL_KEYS: &[&str] = &["command", "working_dir", "timeout_s", "summary", "params"];
+const EXTERNAL_KEYS: &[&str] = &["command", "working_dir", "timeout_s", "kind", "summary", "params"];
 
 /// The keys of a variant of a built-in method (`method = "arap"` with other `params`).
 const VARIANT_KEYS: &[&str] = &["method", "summary", "params"];
@@ -57,6 +57,9 @@ pub struct ExternalEntry {
     pub working_dir: PathBuf,
     pub timeout: Duration,
     pub params: serde_json::Value,
+    /// `kind = "iterative"` (default `"direct"`): a solve without `converged` is then reported as
+    /// "convergence unknown", not finished.
+    pub iterative: bool,
 }
 
 /// The peers of a run (`--peers`): their file and the Python they run in.
@@ -134,6 +137,7 @@ impl ConfiguredMethod {
                 timeout: e.timeout,
                 params: e.params.clone(),
                 stderr_log,
+                iterative: e.iterative,
             })?)),
         }
     }
@@ -544,6 +548,11 @@ fn entry(
             _ => return Err(config("`timeout_s` must be a positive number of seconds".into())),
         },
     };
+    let iterative = match table.get("kind").map(toml::Value::as_str) {
+        None | Some(Some("direct")) => false,
+        Some(Some("iterative")) => true,
+        Some(_) => return Err(config("`kind` is \"direct\" or \"iterative\"".into())),
+    };
     let summary = summary.unwrap_or_else(|| format!("external program `{}`", command.join(" ")));
     let json = serde_json::to_value(&params).map_err(|e| config(format!("params: {e}")))?;
     let mut command = command.into_iter();
@@ -562,6 +571,7 @@ fn entry(
             working_dir,
             timeout,
             params: json,
+            iterative,
         }),
     })
 }

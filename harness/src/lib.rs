@@ -7,6 +7,7 @@ pub mod comparison;
 pub mod config;
 pub mod error;
 pub mod memory;
+pub mod method_check;
 pub mod metrics;
 pub mod pareto;
 pub mod peers;

@@ -231,3 +231,57 @@ fn an_entry_that_cannot_run_here_disables_itself_and_the_others_run() {
         "{text}"
     );
 }
+
+/// Issue 38, item 4: `check-method` runs the protocol on a tiny mesh and says what is wrong: a
+/// well-behaved toy passes (exit 0, every step `ok`), and each broken toy fails at its step with the
+/// reason in plain words (exit 1).
+#[test]
+fn check_method_passes_a_good_method_and_names_what_a_broken_one_gets_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    let toy = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().join("tests/external/toy_method.py");
+    let file = dir.path().join("toys.toml");
+    let entries: String = ["ok", "silent", "nan", "malformed", "old-protocol", "wrong-count"]
+        .iter()
+        .map(|mode| {
+            let kind = if *mode == "silent" { "kind = \"iterative\"\n" } else { "" };
+            format!(
+                "[toy_{}]\ncommand = [\"python3\", \"{}\", \"{mode}\"]\n{kind}\n",
+                mode.replace('-', "_"),
+                toy.display()
+            )
+        })
+        .collect();
+    std::fs::write(&file, entries).unwrap();
+    let check = |name: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_harness"))
+            .args(["check-method", name, "--methods", file.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+        (out.status.code().unwrap_or(-1), text)
+    };
+    let (code, text) = check("toy_ok");
+    assert_eq!(code, 0, "{text}");
+    for step in ["start and hello", "precompute", "first bind", "second bind", "quit"] {
+        assert!(text.lines().any(|l| l.trim_start().starts_with("ok") && l.contains(step)), "{step}: {text}");
+    }
+    assert!(text.contains("speaks the protocol"), "{text}");
+    let (code, text) = check("toy_silent");
+    assert_eq!(code, 0, "{text}");
+    assert!(text.contains("converged: not said"), "{text}");
+    for (toy, step, needle) in [
+        ("toy_nan", "first bind (2 regions) and solve: solve", "non-finite number (NaN)"),
+        ("toy_malformed", "precompute", "not a protocol answer"),
+        ("toy_old_protocol", "start and hello", "version 0"),
+        ("toy_wrong_count", "first bind (2 regions) and solve: solve", "positions"),
+    ] {
+        let (code, text) = check(toy);
+        assert_eq!(code, 1, "{toy}: {text}");
+        let fail =
+            text.lines().find(|l| l.trim_start().starts_with("FAIL")).unwrap_or_else(|| panic!("{text}"));
+        assert!(fail.contains(step) && fail.contains(needle), "{toy}: {fail}");
+    }
+    let (code, text) = check("nosuch");
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains("unknown method `nosuch`"), "{text}");
+}

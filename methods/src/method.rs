@@ -53,6 +53,10 @@ pub struct SolveSummary {
     pub converged: bool,
     /// Step of the last iteration.
     pub final_step: f64,
+    /// An iterative method that did not say whether it converged (an external entry of
+    /// `kind = "iterative"` whose answer has no `converged`): counted as finished, reported as
+    /// "convergence unknown".
+    pub convergence_unknown: bool,
 }
 
 /// A handle-based deformation method, driven through the phases the papers time separately:
@@ -140,8 +144,12 @@ pub(crate) fn run_iterations<S: ?Sized>(
     shape: impl Fn(&S) -> Vec<[f64; 3]>,
     observer: &mut dyn IterationObserver,
 ) -> Result<SolveSummary, MethodError> {
-    let mut summary =
-        SolveSummary { iterations: iterations.first, converged: false, final_step: f64::INFINITY };
+    let mut summary = SolveSummary {
+        iterations: iterations.first,
+        converged: false,
+        final_step: f64::INFINITY,
+        convergence_unknown: false,
+    };
     for iteration in iterations.first..iterations.first + iterations.count {
         let start = std::time::Instant::now();
         let step = iterate(state, iteration)?;
@@ -150,6 +158,7 @@ pub(crate) fn run_iterations<S: ?Sized>(
             iterations: iteration + 1,
             converged: step < iterations.tolerance,
             final_step: step,
+            convergence_unknown: false,
         };
         let state: &S = state;
         let flow = observer.on_iteration(&report, Some(&|| shape(state)));

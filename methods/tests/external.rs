@@ -28,6 +28,7 @@ fn spec(mode: &str, extra: &[&str], timeout: Duration) -> ExternalSpec {
         timeout,
         params: serde_json::json!({}),
         stderr_log: None,
+        iterative: false,
     }
 }
 

@@ -216,7 +216,13 @@ pub fn render_index(
             r.vertices,
             r.iterations,
             r.iterations,
-            if r.converged { "yes" } else { "no" },
+            if r.convergence_unknown {
+                "unknown"
+            } else if r.converged {
+                "yes"
+            } else {
+                "no"
+            },
             timing(r.startup_s, r.spread.map(|s| (s.repetitions, s.startup_s)), 3),
             timing(r.precompute_s, r.spread.map(|s| (s.repetitions, s.precompute_s)), 3),
             timing(r.bind_s, r.spread.map(|s| (s.repetitions, s.bind_s)), 4),

@@ -146,7 +146,7 @@ pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
             r.iterations.to_string(),
             num(r.solve_s),
             num(r.total_s),
-            r.converged.to_string(),
+            if r.convergence_unknown { "unknown".to_string() } else { r.converged.to_string() },
         ];
         let spread = r.spread.unwrap_or_default();
         row.push(spread.repetitions.to_string());

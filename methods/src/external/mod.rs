@@ -46,6 +46,9 @@ pub struct ExternalSpec {
     pub params: serde_json::Value,
     /// Where its stderr is written (none: kept only for error messages).
     pub stderr_log: Option<PathBuf>,
+    /// Whether it iterates (`kind = "iterative"`): then a solve without `converged` is reported as
+    /// "convergence unknown"; a direct method's solve is finished by definition.
+    pub iterative: bool,
 }
 
 /// A running external method.
@@ -237,7 +240,14 @@ impl DeformationMethod for ExternalMethod {
         }
         let iterations = answer.iterations.unwrap_or(answer.trace.len());
         let final_step = answer.final_step.or(answer.trace.last().map(|t| t.step)).unwrap_or(f64::NAN);
-        Ok(SolveSummary { iterations, converged: answer.converged.unwrap_or(true), final_step })
+        // A direct method has nothing to report; an iterative one that says nothing cannot be told
+        // from one that stopped early, and is reported so.
+        Ok(SolveSummary {
+            iterations,
+            converged: answer.converged.unwrap_or(true),
+            final_step,
+            convergence_unknown: self.spec.iterative && answer.converged.is_none(),
+        })
     }
 
     fn positions(&self) -> Vec<[f64; 3]> {

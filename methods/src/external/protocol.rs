@@ -46,7 +46,7 @@ pub struct Answer {
     /// `hello`: the protocol name and version the program speaks.
     #[serde(default)]
     pub protocol: Option<String>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "whole_number")]
     pub version: Option<u32>,
     /// `hello`: free text on what runs (e.g. "libigl 2.6.3 arap, SPOKES energy"), shown in reports.
     #[serde(default)]
@@ -57,7 +57,7 @@ pub struct Answer {
     /// `solve`: the method's own iteration count, convergence flag and last step (over the rest
     /// bounding-box diagonal). Without `converged` the solve counts as finished (a direct method, or
     /// one that cannot tell).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "whole_number")]
     pub iterations: Option<usize>,
     #[serde(default)]
     pub converged: Option<bool>,
@@ -72,6 +72,20 @@ pub struct Answer {
     /// `solve`: one entry per iteration.
     #[serde(default)]
     pub trace: Vec<TraceEntry>,
+}
+
+/// A count: a JSON integer, or a number with an integral value (`300.0`, as a language without an
+/// integer type writes it); a fraction or a negative number is an error.
+fn whole_number<'de, D, T>(deserializer: D) -> Result<Option<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: TryFrom<u64>,
+{
+    let Some(value) = Option::<f64>::deserialize(deserializer)? else { return Ok(None) };
+    if value.fract() != 0.0 || !(0.0..=9.007_199_254_740_992e15).contains(&value) {
+        return Err(serde::de::Error::custom(format!("{value} is not a count (a whole number >= 0)")));
+    }
+    T::try_from(value as u64).map(Some).map_err(|_| serde::de::Error::custom(format!("{value} is too large")))
 }
 
 /// One iteration of a `solve` as the method reports it.
@@ -105,10 +119,37 @@ pub fn decode(line: &str) -> Result<Answer, String> {
                 &token_at[..token_at.find([',', ']', '}']).unwrap_or(token_at.len()).min(9)],
                 e.column()
             )
+        } else if e.is_eof() {
+            format!(
+                "answered a line that ends inside a JSON value: an answer is one line (print it without \
+                 indentation or line breaks); the line was: {}",
+                excerpt(text)
+            )
         } else {
-            format!("answered a line that is not a protocol answer ({e}): {}", excerpt(text))
+            format!(
+                "answered a line that is not a protocol answer ({}); around column {}: {}",
+                e.to_string().split(" at line ").next().unwrap_or_default(),
+                e.column(),
+                around(text, e.column())
+            )
         }
     })
+}
+
+/// The text of `line` around 1-based `column` (60 characters either side, `⟨here⟩` at the column),
+/// so an error in a long answer quotes the place, not the line's start.
+pub fn around(line: &str, column: usize) -> String {
+    const SIDE: usize = 60;
+    let at = line.char_indices().map(|(i, _)| i).nth(column.saturating_sub(1)).unwrap_or(line.len());
+    let start = line[..at].char_indices().rev().nth(SIDE - 1).map_or(0, |(i, _)| i);
+    let end = line[at..].char_indices().nth(SIDE).map_or(line.len(), |(i, _)| at + i);
+    format!(
+        "{}{}⟨here⟩{}{}",
+        if start > 0 { "…" } else { "" },
+        &line[start..at],
+        &line[at..end],
+        if end < line.len() { "…" } else { "" }
+    )
 }
 
 /// The start of a long line, for error messages.
@@ -163,5 +204,23 @@ mod tests {
         assert!(wrong.contains("not a protocol answer"), "{wrong}");
         let answer = decode("{\"ok\": true, \"iterations\": 3, \"extra\": 1}").unwrap();
         assert!(answer.ok && answer.iterations == Some(3));
+    }
+
+    /// Issue 38: counts may be integral floats; a fraction is named with the place it is at, deep
+    /// in a long line; an answer spread over lines (pretty-printed) is named as such.
+    #[test]
+    fn counts_may_be_integral_floats_and_errors_quote_their_place() {
+        let answer = decode("{\"ok\": true, \"iterations\": 300.0, \"version\": 1.0}").unwrap();
+        assert_eq!((answer.iterations, answer.version), (Some(300), Some(1)));
+        let positions = vec!["[0.5, 0.25, 1.0]"; 5000].join(", ");
+        let line = format!("{{\"ok\": true, \"positions\": [{positions}], \"iterations\": 300.5}}");
+        let err = decode(&line).unwrap_err();
+        assert!(err.contains("300.5 is not a count"), "{err}");
+        assert!(err.contains("\"iterations\": 300.5") && err.contains("⟨here⟩"), "quotes the place: {err}");
+        assert!(err.len() < 400, "not the whole line: {} characters", err.len());
+        let err = decode("{").unwrap_err();
+        assert!(err.contains("one line"), "{err}");
+        let err = decode("{\"ok\": true, \"iterations\": -3}").unwrap_err();
+        assert!(err.contains("not a count"), "{err}");
     }
 }

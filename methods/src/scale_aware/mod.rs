@@ -405,7 +405,8 @@ impl DeformationMethod for ScaleAware {
         let step = max_displacement(&before, &self.current) / diagonal;
         let report = IterationReport { iteration: 0, step, seconds: self.timings.initialization };
         let current: &[[f64; 3]] = &self.current;
-        let summary = SolveSummary { iterations: 1, converged: false, final_step: step };
+        let summary =
+            SolveSummary { iterations: 1, converged: false, final_step: step, convergence_unknown: false };
         if observer.on_iteration(&report, Some(&|| current.to_vec())) == ControlFlow::Break(()) {
             return Ok(summary);
         }

@@ -429,7 +429,7 @@ impl DeformationMethod for SpectralMhb {
         let report = IterationReport { iteration: 0, step, seconds: start.elapsed().as_secs_f64() };
         let current = &self.current;
         let _ = observer.on_iteration(&report, Some(&|| current.clone()));
-        Ok(SolveSummary { iterations: 1, converged: true, final_step: step })
+        Ok(SolveSummary { iterations: 1, converged: true, final_step: step, convergence_unknown: false })
     }
 
     fn positions(&self) -> Vec<[f64; 3]> {
