@@ -541,6 +541,8 @@ pub fn run_case(
             reference_finished,
         };
         let mut reasons = rules.reasons(&result.quality, motion);
+        // A process that outlived its case is the case's to say (the token kill missed it).
+        reasons.extend(m.end());
         if result.convergence_unknown {
             reasons.push(CONVERGENCE_UNKNOWN.to_string());
         }

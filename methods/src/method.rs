@@ -107,6 +107,12 @@ pub trait DeformationMethod: Send {
     fn about(&self) -> Option<String> {
         None
     }
+
+    /// End what the method holds outside this process (an external program and whatever it
+    /// started) once its case is done; what could not be ended, in words for the case's status.
+    fn end(&mut self) -> Vec<String> {
+        Vec::new()
+    }
 }
 
 /// Phase timings or statistics under their `&'static` keys ([`crate::keys`]) as the trait reports them.

@@ -269,27 +269,29 @@ impl DeformationMethod for ExternalMethod {
     fn about(&self) -> Option<String> {
         self.about.clone()
     }
+
+    fn end(&mut self) -> Vec<String> {
+        self.process.finish(protocol::encode(&Request::Quit));
+        let escaped = self.process.escaped();
+        if !escaped.killed.is_empty() {
+            eprintln!(
+                "warning: method `{}`: killed {} process(es) it started that had left its process group (pids {:?})",
+                self.spec.name,
+                escaped.killed.len(),
+                escaped.killed
+            );
+        }
+        if escaped.alive.is_empty() {
+            Vec::new()
+        } else {
+            vec![format!("left processes running: {:?} outlived SIGKILL", escaped.alive)]
+        }
+    }
 }
 
 impl Drop for ExternalMethod {
     fn drop(&mut self) {
+        // After `end` (the case's), a no-op; a method dropped on an error path ends here.
         self.process.finish(protocol::encode(&Request::Quit));
-        // A process that left the method's group (setsid, a daemon's double fork) is killed by its
-        // token; that it had escaped is worth a word, and one that survived SIGKILL more so.
-        let escaped = self.process.escaped();
-        if !escaped.killed.is_empty() {
-            eprintln!(
-                "warning: method `{}`: killed {} process(es) it started that had left its process group \
-                 (pids {:?}){}",
-                self.spec.name,
-                escaped.killed.len(),
-                escaped.killed,
-                if escaped.alive.is_empty() {
-                    String::new()
-                } else {
-                    format!("; still running after SIGKILL: {:?}", escaped.alive)
-                }
-            );
-        }
     }
 }
