@@ -283,8 +283,9 @@ pub enum DataSource {
 }
 
 /// Above this many vertices a scenario's result meshes and 3D-view files are written only when it
-/// says `result_meshes = true` or the run asks `--every-mesh`: a 1M-vertex case writes 24 MB of
-/// `.glb` and 20 MB of view data, and a page of such cases stops being something to open.
+/// says `result_meshes = true` or the run asks `--every-mesh`: a 1M-vertex case writes 48 MB of
+/// `.glb` and 8 MB of view data (its test's rest mesh another 41 MB), and a page of such cases
+/// stops being something to open.
 pub const RESULT_MESHES_MAX_VERTICES: usize = 200_000;
 
 /// A scenario ready to run: validated mesh, handles and targets.
