@@ -7,7 +7,7 @@
 // Drawn with WebGL 2 where the browser has it: the faces and their colours go to the GPU once per
 // case and colouring, and a redraw while turning only changes the camera: even on a software GPU
 // (SwiftShader, headless Chromium on 2 cores) two views of a million faces each redraw in about
-// 0.6 s. Where getContext('webgl2') gives nothing (or with `renderer=canvas` in the address) a 2D
+// 0.7 s, and 0.23-0.32 s while turning with the coarser copy (below) at 1-4.3M faces. Where getContext('webgl2') gives nothing (or with `renderer=canvas` in the address) a 2D
 // canvas draws instead, sorting and filling every face per redraw (painter's algorithm): the same
 // picture, in about 0.1 s at ten thousand faces a view, 0.6 s at 80K, 8 s at a million.
 // Meshes load per case from viewer/*.js (report/viewer.rs), not with the page.
