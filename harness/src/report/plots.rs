@@ -636,28 +636,7 @@ fn draw_dataset_cost<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResul
                 .collect()
         };
         let all: Vec<(f64, f64)> = methods.iter().flat_map(|m| points(m)).collect();
-        let (x0, x1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
-        let (y0, y1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
-        if !x0.is_finite() {
-            continue;
-        }
-        let mut chart = ChartBuilder::on(&panel)
-            .caption(label, ("sans-serif", 18))
-            .margin(10)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d((x0 * 0.8..x1 * 1.25).log_scale(), (y0 * 0.5..y1 * 2.0).log_scale())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("vertices")
-            .y_desc("seconds")
-            .x_labels(6)
-            .x_label_formatter(&|v| vertex_count_label(*v))
-            .y_label_formatter(&|v| format!("{}", round_to_two_digits(*v)))
-            .label_style(("sans-serif", 13))
-            .draw()
-            .map_err(err)?;
+        let Some(mut chart) = against_vertices(&panel, label, "seconds", &all)? else { continue };
         for m in &methods {
             let p = points(m);
             if p.is_empty() {
@@ -716,28 +695,7 @@ fn draw_size_series<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult
         };
         let all: Vec<(f64, f64)> =
             series.iter().flat_map(|s| methods.iter().flat_map(move |m| points(s, m))).collect();
-        let (x0, x1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
-        let (y0, y1) = all.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
-        if !x0.is_finite() {
-            continue;
-        }
-        let mut chart = ChartBuilder::on(&panel)
-            .caption(label, ("sans-serif", 18))
-            .margin(10)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d((x0 * 0.8..x1 * 1.25).log_scale(), (y0 * 0.5..y1 * 2.0).log_scale())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("vertices")
-            .y_desc(unit)
-            .x_labels(6)
-            .x_label_formatter(&|v| vertex_count_label(*v))
-            .y_label_formatter(&|v| format!("{}", round_to_two_digits(*v)))
-            .label_style(("sans-serif", 13))
-            .draw()
-            .map_err(err)?;
+        let Some(mut chart) = against_vertices(&panel, label, unit, &all)? else { continue };
         for (k, s) in series.iter().enumerate() {
             for m in &methods {
                 let p = points(s, m);
@@ -766,6 +724,40 @@ fn draw_size_series<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult
         draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, 12)?;
     }
     Ok(())
+}
+
+/// Log-log axes of `unit` against vertex count on `panel`, captioned `label`, spanning `points`
+/// with a margin; `None` when there is no point to draw.
+#[allow(clippy::type_complexity)]
+fn against_vertices<'a, DB: DrawingBackend>(
+    panel: &Area<'a, DB>,
+    label: &str,
+    unit: &str,
+    points: &[(f64, f64)],
+) -> Result<Option<ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>>, String> {
+    let (x0, x1) = points.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let (y0, y1) = points.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    if !x0.is_finite() {
+        return Ok(None);
+    }
+    let mut chart = ChartBuilder::on(panel)
+        .caption(label, ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x0 * 0.8..x1 * 1.25).log_scale(), (y0 * 0.5..y1 * 2.0).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("vertices")
+        .y_desc(unit)
+        .x_labels(6)
+        .x_label_formatter(&|v| vertex_count_label(*v))
+        .y_label_formatter(&|v| format!("{}", round_to_two_digits(*v)))
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(err)?;
+    Ok(Some(chart))
 }
 
 /// A vertex count for an axis: `6K`, `50K`, `1.2M`.
