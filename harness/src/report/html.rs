@@ -139,18 +139,16 @@ pub fn render_index(
             image(&mut page, p, caption_for(p));
         }
     }
+    answer_first(&mut page);
     if !size_series.is_empty() {
         page.push_str(
-            "<h2 id=\"size-series\">Cost against size</h2>\n<p>The same tables as <code>size-series.md</code>: one \
-             shape at several sizes, every case's time per phase, memory and status, the methods left out and why, and \
-             each method's fitted slopes against #V.</p>\n",
+            "<h2 id=\"size-series\">Cost against size</h2>\n<p>(Also in <code>size-series.md</code>.)</p>\n",
         );
         page.push_str(&markdown_table(&size_series.replace("\n## ", "\nSeries: ")));
         for p in series_images {
             image(&mut page, p, caption_for(p));
         }
     }
-    answer_first(&mut page);
 
     page.push_str(
         "<h2 id=\"results\">Results</h2>\n<div id=\"filters\"></div>\n<div class=\"scroll\"><table id=\"results-table\">\n<thead><tr>\
