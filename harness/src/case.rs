@@ -73,6 +73,10 @@ pub struct StepRecord {
     pub final_step: f64,
     #[serde(deserialize_with = "nan_from_null")]
     pub median_iteration_ms: f64,
+    /// Seconds of `solve_s` that the method took from an identical solve of another method's case
+    /// instead of computing them ([`methods::DeformationMethod::reused_solve`]); 0: none.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub reused_solve_s: f64,
     /// The method's phase timings after this step (e.g. HIRM's `t_h_handle_update`).
     pub phase_timings: Vec<(String, f64)>,
 }
@@ -153,6 +157,10 @@ pub struct CaseResult {
     pub phase_timings: Vec<(String, f64)>,
     /// Sizes of a reduced model (e.g. HIRM's `n_field`), after the last step.
     pub statistics: Vec<(String, f64)>,
+    /// Where part of the solve was taken from another method's identical solve instead of being
+    /// computed: that method and the seconds taken, which `solve_s` and `total_s` include.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reused_solve: Option<ReusedSolveRecord>,
     /// Every edit step (one for a single edit); the top-level bind, solve and iteration figures
     /// are the first step's bind and the sums and median over all steps.
     pub steps: Vec<StepRecord>,
@@ -168,6 +176,19 @@ pub struct CaseResult {
     pub spread: Option<TimingSpread>,
     #[serde(skip)]
     pub positions: Option<Vec<[f64; 3]>>,
+}
+
+/// The solve time a case took from another method's case ([`CaseResult::reused_solve`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReusedSolveRecord {
+    /// The method that computed it.
+    pub from: String,
+    /// Seconds taken, over all edit steps.
+    pub seconds: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// The smallest and largest of a timing over the repetitions.
@@ -326,7 +347,7 @@ pub(crate) fn repetition(
     let start = Instant::now();
     m.precompute(&scenario.mesh)?;
     let precompute_s = start.elapsed().as_secs_f64();
-    let (mut first_bind_s, mut solve_s) = (f64::NAN, 0.0);
+    let (mut first_bind_s, mut solve_s, mut reused_s) = (f64::NAN, 0.0, 0.0);
     for step in &scenario.steps {
         let targets = step.targets(&m.positions())?;
         let t = Instant::now();
@@ -337,8 +358,10 @@ pub(crate) fn repetition(
         let t = Instant::now();
         m.solve(&targets, &mut clock)?;
         solve_s += t.elapsed().as_secs_f64();
+        reused_s += m.reused_solve().map_or(0.0, |r| r.seconds);
     }
-    let total_s = start.elapsed().as_secs_f64();
+    solve_s += reused_s;
+    let total_s = start.elapsed().as_secs_f64() + reused_s;
     let median_iteration_ms = median_of_seconds_ms(clock.0);
     Ok((
         Timings { startup_s, precompute_s, bind_s: first_bind_s, median_iteration_ms, solve_s, total_s },
@@ -474,8 +497,17 @@ pub fn run_case(
             let quality_before = recorder.quality_s;
             let t = Instant::now();
             let summary = m.solve(&targets, &mut recorder)?;
-            let step_solve_s = t.elapsed().as_secs_f64() - (recorder.quality_s - quality_before);
+            let reused = m.reused_solve();
+            let reused_solve_s = reused.as_ref().map_or(0.0, |r| r.seconds);
+            let step_solve_s =
+                t.elapsed().as_secs_f64() - (recorder.quality_s - quality_before) + reused_solve_s;
             solve_s += step_solve_s;
+            if let Some(r) = reused {
+                let record = result
+                    .reused_solve
+                    .get_or_insert(ReusedSolveRecord { from: r.from.to_string(), seconds: 0.0 });
+                record.seconds += r.seconds;
+            }
             result.iterations += summary.iterations;
             result.convergence_unknown |= summary.convergence_unknown;
             if !summary.converged {
@@ -498,6 +530,7 @@ pub fn run_case(
                 converged: summary.converged,
                 final_step: summary.final_step,
                 median_iteration_ms: median_ms(&recorder.trace[first_iteration..]),
+                reused_solve_s,
                 phase_timings: m.phase_timings(),
             });
             final_edit = Some((step, targets));
@@ -506,7 +539,8 @@ pub fn run_case(
         let positions = m.positions();
         result.bind_s = result.steps.first().map_or(f64::NAN, |s| s.bind_s);
         result.solve_s = solve_s;
-        result.total_s = start.elapsed().as_secs_f64() - recorder.quality_s;
+        let reused_s = result.reused_solve.as_ref().map_or(0.0, |r| r.seconds);
+        result.total_s = start.elapsed().as_secs_f64() - recorder.quality_s + reused_s;
         result.peak_memory_mib = crate::memory::peak_since(memory).unwrap_or(f64::NAN);
         result.phase_timings = m.phase_timings();
         result.statistics = m.model_statistics();
@@ -671,6 +705,7 @@ impl CaseResult {
             status: Status::Ok,
             phase_timings: Vec::new(),
             statistics: Vec::new(),
+            reused_solve: None,
             steps: Vec::new(),
             trace: Vec::new(),
             overhead: MeasurementTime::default(),

@@ -21,4 +21,6 @@ pub mod spectral_mhb;
 
 pub use error::MethodError;
 pub use handles::{HandleRegion, HandleSet, HandleTargets};
-pub use method::{DeformationMethod, IterationObserver, IterationReport, NoObserver, SolveSummary};
+pub use method::{
+    DeformationMethod, IterationObserver, IterationReport, NoObserver, ReusedSolve, SolveSummary,
+};

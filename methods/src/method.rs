@@ -59,6 +59,15 @@ pub struct SolveSummary {
     pub convergence_unknown: bool,
 }
 
+/// A solve's part that was reused, not computed ([`DeformationMethod::reused_solve`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReusedSolve {
+    /// The method whose solve it was.
+    pub from: &'static str,
+    /// Wall seconds that solve took when it ran.
+    pub seconds: f64,
+}
+
 /// A handle-based deformation method, driven through the phases the papers time separately:
 ///
 /// 1. [`precompute`](Self::precompute): handle-independent work on the rest mesh;
@@ -105,6 +114,14 @@ pub trait DeformationMethod: Send {
 
     /// What runs, in the method's words (an external program's library and version), if it says.
     fn about(&self) -> Option<String> {
+        None
+    }
+
+    /// The part of the last [`solve`](Self::solve) that was not computed but taken from an earlier
+    /// identical solve of another method in this process (`scale_aware_ora` takes `scale_aware`'s):
+    /// its method and the seconds it took there. The wall time of `solve` does not include them; a
+    /// timer of the solve adds them, so that the reported time is that of the whole computation.
+    fn reused_solve(&self) -> Option<ReusedSolve> {
         None
     }
 

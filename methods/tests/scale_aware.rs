@@ -183,6 +183,77 @@ fn ora_variant_runs_and_stays_near_the_handles() {
     assert!(m.phase_timings().iter().any(|(k, _)| *k == methods::keys::phase::ORA_STITCHING));
 }
 
+/// Records every iteration report, and the iterate of the first three.
+struct Reports(Vec<(methods::IterationReport, Option<Vec<[f64; 3]>>)>);
+
+impl methods::IterationObserver for Reports {
+    fn on_iteration(
+        &mut self,
+        report: &methods::IterationReport,
+        shape: Option<&dyn Fn() -> Vec<[f64; 3]>>,
+    ) -> std::ops::ControlFlow<()> {
+        let iterate = if report.iteration < 3 { shape.map(|shape| shape()) } else { None };
+        self.0.push((*report, iterate));
+        std::ops::ControlFlow::Continue(())
+    }
+}
+
+#[test]
+fn ora_takes_an_identical_scale_aware_solve_and_gives_the_same_result() {
+    // A mesh of its own (no other test solves it), so the first ORA solve finds nothing to take.
+    let shape = generate(ShapeKind::Cylinder, 640).unwrap();
+    let region = |name: &str, status| HandleRegion {
+        name: name.into(),
+        vertices: meshes::edit::vertices_with_status(&shape.selection, status),
+    };
+    let regions = vec![region("fixed", VertexStatus::Fixed), region("handle", VertexStatus::Handle)];
+    let handles = HandleSet::new(regions, shape.mesh.n_vertices()).unwrap();
+    let mesh = shape.mesh;
+    let bent: Vec<[f64; 3]> =
+        mesh.positions().iter().map(|p| [p[0] + 0.2 * p[2] * p[2], p[1], p[2]]).collect();
+    let targets = targets_from(&handles, &bent);
+    let run = |params: ScaleAwareParams, name: &'static str| {
+        let mut m = ScaleAware::new(name, params).unwrap();
+        m.precompute(&mesh).unwrap();
+        m.bind_handles(&handles).unwrap();
+        let mut reports = Reports(Vec::new());
+        let summary = m.solve(&targets, &mut reports).unwrap();
+        (m, summary, reports.0)
+    };
+    // A second edit step from the (stitched) result: no solve of it is stored, so it is computed.
+    let second_step = |m: &mut ScaleAware| {
+        let further =
+            targets_from(&handles, &bent.iter().map(|p| [p[0], p[1] + 0.1 * p[2], p[2]]).collect::<Vec<_>>());
+        m.solve(&further, &mut NoObserver).unwrap();
+        assert_eq!(m.reused_solve(), None);
+        m.positions()
+    };
+    let ora = ScaleAwareParams { optimal_rigidity: true, ..Default::default() };
+    let (mut computed, computed_summary, computed_reports) = run(ora.clone(), "scale_aware_ora");
+    assert_eq!(computed.reused_solve(), None, "nothing to take yet");
+    let (plain, plain_summary, _) = run(ScaleAwareParams::default(), "scale_aware");
+    assert_eq!(plain.reused_solve(), None, "scale_aware never takes a solve");
+    assert_eq!(plain_summary.iterations + 1, computed_summary.iterations, "ORA adds one stitching step");
+    let (mut taken, taken_summary, taken_reports) = run(ora.clone(), "scale_aware_ora");
+    let reused = taken.reused_solve().expect("the scale_aware solve of the same inputs is taken");
+    assert_eq!(reused.from, "scale_aware");
+    assert!(reused.seconds > 0.0);
+    assert_eq!(taken.positions(), computed.positions(), "taking the solve changes no bit of the result");
+    assert_eq!(taken_summary, computed_summary);
+    assert_eq!(taken_reports.len(), computed_reports.len());
+    for ((t, t_iterate), (c, c_iterate)) in taken_reports.iter().zip(&computed_reports) {
+        assert_eq!((t.iteration, t.step), (c.iteration, c.step));
+        assert_eq!(t_iterate, c_iterate, "iteration {}: the iterate the observer asked for", t.iteration);
+    }
+    assert!(taken_reports[1].1.is_some(), "the iterates asked for are replayed");
+    assert!(max_distance(&plain.positions(), &taken.positions()) > 0.0, "the stitching moved the result");
+    assert_eq!(second_step(&mut taken), second_step(&mut computed), "nor that of the next edit step");
+
+    // Another constraint weight: a solve of other inputs is not taken.
+    let (other, _, _) = run(ScaleAwareParams { constraint_weight: 50.0, ..ora }, "scale_aware_ora");
+    assert_eq!(other.reused_solve(), None, "another lambda is another solve");
+}
+
 #[test]
 fn anderson_acceleration_finds_the_fixed_point_sooner() {
     // T(x) = A x + b with a slow contraction A = diag(0.99, 0.5, 0.9): fixed point b_i / (1 - a_i).

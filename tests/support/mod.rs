@@ -149,9 +149,13 @@ pub fn timeless(case: &serde_json::Value) -> serde_json::Value {
     ] {
         object.remove(key);
     }
+    // Which method a solve was taken from stays; how long it took there is a timing.
+    if let Some(reused) = object.get_mut("reused_solve").and_then(|r| r.as_object_mut()) {
+        reused.remove("seconds");
+    }
     for step in object.get_mut("steps").unwrap().as_array_mut().unwrap() {
         let step = step.as_object_mut().unwrap();
-        for key in ["bind_s", "solve_s", "median_iteration_ms", "phase_timings"] {
+        for key in ["bind_s", "solve_s", "median_iteration_ms", "reused_solve_s", "phase_timings"] {
             step.remove(key);
         }
     }

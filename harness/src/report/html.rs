@@ -175,7 +175,20 @@ pub fn render_index(
     );
     for r in results {
         let (class, badge) = match r.origin {
-            Origin::BuiltIn => (r.status.kind().to_string(), String::new()),
+            Origin::BuiltIn => (
+                r.status.kind().to_string(),
+                r.reused_solve.as_ref().map_or(String::new(), |reused| {
+                    format!(
+                        "<span class=\"origin\" title=\"{}\">reuses {}</span>",
+                        escape(&format!(
+                            "its solve time includes {:.3} s of {}'s identical solve on this case, \
+                             taken from that case instead of computed again",
+                            reused.seconds, reused.from
+                        )),
+                        escape(&reused.from)
+                    )
+                }),
+            ),
             other => (
                 format!("{} {}", r.status.kind(), other.label()),
                 format!(

@@ -45,6 +45,7 @@ const CASE_COLUMNS: &[&str] = &[
     "startup_s_min",
     "startup_s_max",
     "peak_memory_mib",
+    "reused_solve_s",
 ];
 
 /// The CSV columns after the metrics.
@@ -162,6 +163,7 @@ pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
             row.extend([num(min), num(max)]);
         }
         row.push(num(r.peak_memory_mib));
+        row.push(r.reused_solve.as_ref().map(|reused| num(reused.seconds)).unwrap_or_default());
         row.extend(METRICS.iter().map(|s| r.quality.get(s.metric).map(num).unwrap_or_default()));
         row.extend([
             num(r.largest_move_over_diag),

@@ -42,6 +42,14 @@
 //!   300). The outer iteration is therefore Anderson-accelerated ([`crate::linalg::anderson`],
 //!   depth 5 by default; `anderson_depth = 0` is the plain iteration). It does not change the fixed points, and the
 //!   convergence test uses the fixed-point residual `|T(x) - x|`, which is the plain step.
+//! - `scale_aware_ora` runs Algorithm 1 exactly as `scale_aware` does, so where `scale_aware` has
+//!   just solved the same inputs in this process (the same rest mesh, parameters, handles, targets
+//!   and start shape: a case of each on one scenario edit step), it takes that result
+//!   ([`converged_solves`]) and only stitches; [`DeformationMethod::reused_solve`] reports the
+//!   seconds of the solve it took, which the harness adds to its solve time. The iterations of the
+//!   taken solve are reported again, with the iterates its observer asked for (the harness's angle
+//!   errors of the trace), so that traces and counts are those of the computation. An observer that stops such a replay gets the taken
+//!   solve's final shape.
 //! - Step one's inner loop rarely meets `normal_tolerance` within `normal_iterations`: the smooth
 //!   rotation of the Gauss map that carries the bend is its slowest mode, and the outer iteration
 //!   depends on it not converging (fully converged, step one would rotate the rest normals
@@ -49,6 +57,7 @@
 //!   at 0.44 after 50 outer iterations, with slower outer convergence the more inner iterations;
 //!   20 is the paper's upper figure and the default.
 
+pub mod converged_solves;
 pub mod gauss_map;
 pub mod optimal_rigidity;
 pub mod scale_aware_equations;
@@ -76,10 +85,11 @@ use crate::laplacian::{LaplacianEditing, LaplacianParams};
 use crate::laplacian_coordinates::DeltaFrame;
 use crate::method::{
     max_displacement, move_to, run_iterations, DeformationMethod, IterationObserver, IterationReport,
-    Iterations, NoObserver, SolveSummary,
+    Iterations, NoObserver, ReusedSolve, SolveSummary,
 };
 use crate::operators::LaplacianWeights;
 use crate::rotation_fit::Mat3;
+use converged_solves::{ConvergedSolve, Fingerprint, FingerprintBuilder, RecordingObserver};
 
 /// Parameters of [`ScaleAware`] (configs/methods.toml, sections `[scale_aware]` and
 /// `[scale_aware_ora]`).
@@ -131,6 +141,8 @@ struct RestState {
     pyramids: NormalPyramids,
     rest_areas: Vec<f64>,
     bbox_diagonal: f64,
+    /// The rest mesh and the parameters of Algorithm 1, for [`converged_solves`].
+    fingerprint: Fingerprint,
 }
 
 /// Everything built for one handle set.
@@ -172,6 +184,8 @@ pub struct ScaleAware {
     flat_g: Vec<f64>,
     flat_next: Vec<f64>,
     timings: SolveTimings,
+    /// The solve the last `solve` took from `scale_aware` instead of computing it.
+    reused: Option<ReusedSolve>,
 }
 
 impl ScaleAware {
@@ -223,6 +237,7 @@ impl ScaleAware {
             flat_g: Vec::new(),
             flat_next: Vec::new(),
             timings: SolveTimings::default(),
+            reused: None,
         })
     }
 
@@ -292,6 +307,89 @@ impl ScaleAware {
         }
     }
 
+    /// Algorithm 1 from the current shape: the initialization (iteration 0), then the outer
+    /// iterations until converged or `max_iterations`.
+    fn algorithm_one(
+        &mut self,
+        targets: &HandleTargets,
+        observer: &mut dyn IterationObserver,
+    ) -> Result<SolveSummary, MethodError> {
+        self.timings = SolveTimings::default();
+        let diagonal = self.rest.as_ref().expect("bound implies precomputed").bbox_diagonal;
+
+        // Iteration 0: the initialization.
+        let start = Instant::now();
+        let before = self.current.clone();
+        self.initialize(targets)?;
+        self.timings.initialization = start.elapsed().as_secs_f64();
+        let step = max_displacement(&before, &self.current) / diagonal;
+        let report = IterationReport { iteration: 0, step, seconds: self.timings.initialization };
+        let current: &[[f64; 3]] = &self.current;
+        let summary =
+            SolveSummary { iterations: 1, converged: false, final_step: step, convergence_unknown: false };
+        if observer.on_iteration(&report, Some(&|| current.to_vec())) == ControlFlow::Break(()) {
+            return Ok(summary);
+        }
+
+        // Algorithm 1: x <- T(x), T = step two after step one, optionally Anderson-accelerated.
+        let mut anderson = AndersonAcceleration::new(self.params.anderson_depth, 3 * self.current.len());
+        let iterations =
+            Iterations { first: 1, count: self.params.max_iterations, tolerance: self.params.tolerance };
+        let iterate = |m: &mut Self, iteration: usize| -> Result<f64, MethodError> {
+            let start = Instant::now();
+            m.update_normals();
+            m.timings.step_one_normals += start.elapsed().as_secs_f64();
+            m.recover_vertices(targets)?;
+            m.timings.outer_iterations += 1;
+            // The fixed-point residual |T(x) - x| is the plain iteration's step.
+            let residual = max_displacement_to(&m.current, m.solution.as_ref()) / diagonal;
+            if residual >= m.params.tolerance && m.params.anderson_depth > 0 {
+                m.accelerate(&mut anderson);
+            }
+            move_to(m.name, iteration, &mut m.current, m.solution.as_ref())?;
+            Ok(residual)
+        };
+        run_iterations(iterations, self, iterate, |m| m.current.clone(), observer)
+    }
+
+    /// Stand in for Algorithm 1 with `taken`, an identical solve of `scale_aware`: its result, its
+    /// phase times and its iteration reports (to `observer`, with the iterates that solve's observer
+    /// asked for, and the last).
+    ///
+    /// The initialization is run again (one Laplacian solve, ~1% of Algorithm 1): the SVD warm
+    /// starts it leaves, like step one's `frames` taken here, carry into the next edit step, which
+    /// then gives the same bits as after a computed solve.
+    fn take(
+        &mut self,
+        taken: &ConvergedSolve,
+        targets: &HandleTargets,
+        observer: &mut dyn IterationObserver,
+    ) -> Result<SolveSummary, MethodError> {
+        self.initialize(targets)?;
+        self.current.clone_from(&taken.positions);
+        self.frames.clone_from(&taken.frames);
+        self.timings = taken.timings;
+        self.reused = Some(ReusedSolve { from: crate::registry::SCALE_AWARE, seconds: taken.seconds });
+        let last = taken.reports.len().saturating_sub(1);
+        for (i, (report, iterate)) in taken.reports.iter().enumerate() {
+            let iterate = match iterate {
+                Some(iterate) => Some(iterate),
+                None if i == last => Some(&taken.positions),
+                None => None,
+            };
+            let shape = iterate.map(|iterate| move || iterate.clone());
+            let shape = shape.as_ref().map(|s| s as &dyn Fn() -> Vec<[f64; 3]>);
+            if observer.on_iteration(report, shape) == ControlFlow::Break(()) {
+                return Ok(SolveSummary {
+                    iterations: report.iteration + 1,
+                    converged: false,
+                    ..taken.summary
+                });
+            }
+        }
+        Ok(taken.summary)
+    }
+
     /// Section 5.3: rescale every triangle to its rest area and stitch (eq 13-15).
     fn approximate_rigidity(&mut self, targets: &HandleTargets) -> Result<(), MethodError> {
         let rest = self.rest.as_ref().expect("precomputed");
@@ -332,7 +430,15 @@ impl DeformationMethod for ScaleAware {
         let equations = ScaleAwareEquations::new(n, triangles, measures);
         self.recovery = Some(VertexRecovery::new(&equations)?);
         self.initialization.precompute(rest_mesh)?;
+        // Everything of the parameters but the stitching enters Algorithm 1.
+        let algorithm_one = ScaleAwareParams { optimal_rigidity: false, ..self.params.clone() };
+        let fingerprint = FingerprintBuilder::new()
+            .positions(positions)
+            .value(triangles)
+            .value(&format!("{algorithm_one:?}"))
+            .finish();
         self.rest = Some(RestState {
+            fingerprint,
             triangles: triangles.to_vec(),
             equations,
             pyramids,
@@ -394,46 +500,41 @@ impl DeformationMethod for ScaleAware {
             return Err(MethodError::Phase { method: self.name, phase: "solve", missing: "bind_handles" });
         };
         targets.check_for(&bound.handles)?;
-        self.timings = SolveTimings::default();
-        let diagonal = self.rest.as_ref().expect("bound implies precomputed").bbox_diagonal;
-
-        // Iteration 0: the initialization.
         let start = Instant::now();
-        let before = self.current.clone();
-        self.initialize(targets)?;
-        self.timings.initialization = start.elapsed().as_secs_f64();
-        let step = max_displacement(&before, &self.current) / diagonal;
-        let report = IterationReport { iteration: 0, step, seconds: self.timings.initialization };
-        let current: &[[f64; 3]] = &self.current;
-        let summary =
-            SolveSummary { iterations: 1, converged: false, final_step: step, convergence_unknown: false };
-        if observer.on_iteration(&report, Some(&|| current.to_vec())) == ControlFlow::Break(()) {
-            return Ok(summary);
-        }
-
-        // Algorithm 1: x <- T(x), T = step two after step one, optionally Anderson-accelerated.
-        let mut anderson = AndersonAcceleration::new(self.params.anderson_depth, 3 * self.current.len());
-        let iterations =
-            Iterations { first: 1, count: self.params.max_iterations, tolerance: self.params.tolerance };
-        let iterate = |m: &mut Self, iteration: usize| -> Result<f64, MethodError> {
-            let start = Instant::now();
-            m.update_normals();
-            m.timings.step_one_normals += start.elapsed().as_secs_f64();
-            m.recover_vertices(targets)?;
-            m.timings.outer_iterations += 1;
-            // The fixed-point residual |T(x) - x| is the plain iteration's step.
-            let residual = max_displacement_to(&m.current, m.solution.as_ref()) / diagonal;
-            if residual >= m.params.tolerance && m.params.anderson_depth > 0 {
-                m.accelerate(&mut anderson);
+        self.reused = None;
+        let rest = self.rest.as_ref().expect("bound implies precomputed");
+        let key = FingerprintBuilder::new()
+            .value(&rest.fingerprint)
+            .value(&bound.handles.constrained().collect::<Vec<u32>>())
+            .positions(targets.positions())
+            .positions(&self.current)
+            .value(&rayon::current_num_threads())
+            .finish();
+        let taken = if self.params.optimal_rigidity { converged_solves::find(key) } else { None };
+        let summary = match taken {
+            Some(taken) => self.take(&taken, targets, observer)?,
+            None => {
+                let mut recording =
+                    RecordingObserver { inner: observer, reports: Vec::new(), stopped: false };
+                let summary = self.algorithm_one(targets, &mut recording)?;
+                if !self.params.optimal_rigidity && !recording.stopped {
+                    let solve = ConvergedSolve {
+                        positions: self.current.clone(),
+                        summary,
+                        reports: recording.reports,
+                        timings: self.timings,
+                        frames: self.frames.clone(),
+                        seconds: start.elapsed().as_secs_f64(),
+                    };
+                    converged_solves::store(key, solve);
+                }
+                summary
             }
-            move_to(m.name, iteration, &mut m.current, m.solution.as_ref())?;
-            Ok(residual)
         };
-        let summary = run_iterations(iterations, self, iterate, |m| m.current.clone(), observer)?;
-
         if !self.params.optimal_rigidity {
             return Ok(summary);
         }
+        let diagonal = self.rest.as_ref().expect("bound implies precomputed").bbox_diagonal;
         // The stitching step is no convergence test: a tolerance of infinity never fails it.
         let stitching = Iterations { first: summary.iterations, count: 1, tolerance: f64::INFINITY };
         let stitch = |m: &mut Self, iteration: usize| -> Result<f64, MethodError> {
@@ -449,6 +550,10 @@ impl DeformationMethod for ScaleAware {
 
     fn positions(&self) -> Vec<[f64; 3]> {
         self.current.clone()
+    }
+
+    fn reused_solve(&self) -> Option<ReusedSolve> {
+        self.reused.clone()
     }
 
     fn phase_timings(&self) -> Vec<(String, f64)> {
