@@ -268,24 +268,33 @@ fn running(pid: u32) -> bool {
 }
 
 /// SIGKILL every process carrying `token` (they left the program's group), then which still run.
+///
+/// The carriers are looked for again after every kill until none runs (or half a second has
+/// passed): one that forked between the look and the kill has a child carrying the token too.
 fn kill_carriers(token: &str) -> Escaped {
-    let found: Vec<u32> = carriers(token).into_iter().filter(|&pid| running(pid)).collect();
-    if found.is_empty() {
-        return Escaped::default();
-    }
-    for &pid in &found {
-        // SAFETY: kill(2) on a pid; no memory is shared.
-        unsafe {
-            libc::kill(pid as libc::pid_t, libc::SIGKILL);
-        }
-    }
     let deadline = Instant::now() + Duration::from_millis(500);
-    let mut alive = found.clone();
-    while !alive.is_empty() && Instant::now() < deadline {
+    let mut killed: Vec<u32> = Vec::new();
+    loop {
+        let found: Vec<u32> = carriers(token).into_iter().filter(|&pid| running(pid)).collect();
+        if found.is_empty() {
+            return Escaped { killed, alive: Vec::new() };
+        }
+        for &pid in &found {
+            // SAFETY: kill(2) on a pid; no memory is shared.
+            unsafe {
+                libc::kill(pid as libc::pid_t, libc::SIGKILL);
+            }
+            if !killed.contains(&pid) {
+                killed.push(pid);
+            }
+        }
+        if Instant::now() >= deadline {
+            std::thread::sleep(Duration::from_millis(10));
+            let alive = found.into_iter().filter(|&pid| running(pid)).collect();
+            return Escaped { killed, alive };
+        }
         std::thread::sleep(Duration::from_millis(10));
-        alive.retain(|&pid| running(pid));
     }
-    Escaped { killed: found, alive }
 }
 
 fn write_lines(mut stdin: ChildStdin, lines: Receiver<String>) {
