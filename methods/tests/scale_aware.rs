@@ -16,7 +16,12 @@ use methods::{DeformationMethod, HandleRegion, HandleSet, HandleTargets, MethodE
 
 /// Procedural cylinder (~800 vertices) with its fixed and handle regions.
 fn cylinder() -> (TriMesh, HandleSet) {
-    let shape = generate(ShapeKind::Cylinder, 800).unwrap();
+    cylinder_of(800)
+}
+
+/// Procedural cylinder of about `vertices` vertices with its fixed and handle regions.
+fn cylinder_of(vertices: usize) -> (TriMesh, HandleSet) {
+    let shape = generate(ShapeKind::Cylinder, vertices).unwrap();
     let region = |name: &str, status| HandleRegion {
         name: name.into(),
         vertices: meshes::edit::vertices_with_status(&shape.selection, status),
@@ -201,14 +206,7 @@ impl methods::IterationObserver for Reports {
 #[test]
 fn ora_takes_an_identical_scale_aware_solve_and_gives_the_same_result() {
     // A mesh of its own (no other test solves it), so the first ORA solve finds nothing to take.
-    let shape = generate(ShapeKind::Cylinder, 640).unwrap();
-    let region = |name: &str, status| HandleRegion {
-        name: name.into(),
-        vertices: meshes::edit::vertices_with_status(&shape.selection, status),
-    };
-    let regions = vec![region("fixed", VertexStatus::Fixed), region("handle", VertexStatus::Handle)];
-    let handles = HandleSet::new(regions, shape.mesh.n_vertices()).unwrap();
-    let mesh = shape.mesh;
+    let (mesh, handles) = cylinder_of(640);
     let bent: Vec<[f64; 3]> =
         mesh.positions().iter().map(|p| [p[0] + 0.2 * p[2] * p[2], p[1], p[2]]).collect();
     let targets = targets_from(&handles, &bent);
