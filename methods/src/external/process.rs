@@ -288,12 +288,11 @@ fn kill_carriers(token: &str) -> Escaped {
                 killed.push(pid);
             }
         }
+        std::thread::sleep(Duration::from_millis(10));
         if Instant::now() >= deadline {
-            std::thread::sleep(Duration::from_millis(10));
             let alive = found.into_iter().filter(|&pid| running(pid)).collect();
             return Escaped { killed, alive };
         }
-        std::thread::sleep(Duration::from_millis(10));
     }
 }
 

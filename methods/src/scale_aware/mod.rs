@@ -45,11 +45,11 @@
 //! - `scale_aware_ora` runs Algorithm 1 exactly as `scale_aware` does, so where `scale_aware` has
 //!   just solved the same inputs in this process (the same rest mesh, parameters, handles, targets
 //!   and start shape: a case of each on one scenario edit step), it takes that result
-//!   ([`converged_solves`]) and only stitches; [`DeformationMethod::reused_solve`] reports the
+//!   ([`solve_memo`]) and only stitches; [`DeformationMethod::reused_solve`] reports the
 //!   seconds of the solve it took, which the harness adds to its solve time. The iterations of the
 //!   taken solve are reported again, with the iterates its observer asked for (the harness's angle
-//!   errors of the trace), so that traces and counts are those of the computation. An observer that stops such a replay gets the taken
-//!   solve's final shape.
+//!   errors of the trace), so that traces and counts are those of the computation. An observer
+//!   that stops such a replay gets the taken solve's final shape.
 //! - Step one's inner loop rarely meets `normal_tolerance` within `normal_iterations`: the smooth
 //!   rotation of the Gauss map that carries the bend is its slowest mode, and the outer iteration
 //!   depends on it not converging (fully converged, step one would rotate the rest normals
@@ -57,11 +57,11 @@
 //!   at 0.44 after 50 outer iterations, with slower outer convergence the more inner iterations;
 //!   20 is the paper's upper figure and the default.
 
-pub mod converged_solves;
 pub mod gauss_map;
 pub mod optimal_rigidity;
 pub mod scale_aware_equations;
 pub mod scale_invariant_measures;
+pub mod solve_memo;
 pub mod vertex_recovery;
 
 use std::ops::ControlFlow;
@@ -89,7 +89,7 @@ use crate::method::{
 };
 use crate::operators::LaplacianWeights;
 use crate::rotation_fit::Mat3;
-use converged_solves::{ConvergedSolve, Fingerprint, FingerprintBuilder, RecordingObserver};
+use solve_memo::{Fingerprint, FingerprintBuilder, MemoizedSolve, RecordingObserver};
 
 /// Parameters of [`ScaleAware`] (configs/methods.toml, sections `[scale_aware]` and
 /// `[scale_aware_ora]`).
@@ -141,7 +141,7 @@ struct RestState {
     pyramids: NormalPyramids,
     rest_areas: Vec<f64>,
     bbox_diagonal: f64,
-    /// The rest mesh and the parameters of Algorithm 1, for [`converged_solves`].
+    /// The rest mesh and the parameters of Algorithm 1, for [`solve_memo`].
     fingerprint: Fingerprint,
 }
 
@@ -361,7 +361,7 @@ impl ScaleAware {
     /// then gives the same bits as after a computed solve.
     fn take(
         &mut self,
-        taken: &ConvergedSolve,
+        taken: &MemoizedSolve,
         targets: &HandleTargets,
         observer: &mut dyn IterationObserver,
     ) -> Result<SolveSummary, MethodError> {
@@ -430,7 +430,8 @@ impl DeformationMethod for ScaleAware {
         let equations = ScaleAwareEquations::new(n, triangles, measures);
         self.recovery = Some(VertexRecovery::new(&equations)?);
         self.initialization.precompute(rest_mesh)?;
-        // Everything of the parameters but the stitching enters Algorithm 1.
+        // Everything of the parameters but the stitching enters Algorithm 1 (their `Debug` text:
+        // floats print round-trip exact, so different values give different text).
         let algorithm_one = ScaleAwareParams { optimal_rigidity: false, ..self.params.clone() };
         let fingerprint = FingerprintBuilder::new()
             .positions(positions)
@@ -510,7 +511,7 @@ impl DeformationMethod for ScaleAware {
             .positions(&self.current)
             .value(&rayon::current_num_threads())
             .finish();
-        let taken = if self.params.optimal_rigidity { converged_solves::find(key) } else { None };
+        let taken = if self.params.optimal_rigidity { solve_memo::find(key) } else { None };
         let summary = match taken {
             Some(taken) => self.take(&taken, targets, observer)?,
             None => {
@@ -518,7 +519,7 @@ impl DeformationMethod for ScaleAware {
                     RecordingObserver { inner: observer, reports: Vec::new(), stopped: false };
                 let summary = self.algorithm_one(targets, &mut recording)?;
                 if !self.params.optimal_rigidity && !recording.stopped {
-                    let solve = ConvergedSolve {
+                    let solve = MemoizedSolve {
                         positions: self.current.clone(),
                         summary,
                         reports: recording.reports,
@@ -526,7 +527,7 @@ impl DeformationMethod for ScaleAware {
                         frames: self.frames.clone(),
                         seconds: start.elapsed().as_secs_f64(),
                     };
-                    converged_solves::store(key, solve);
+                    solve_memo::store(key, solve);
                 }
                 summary
             }

@@ -68,8 +68,9 @@ impl FingerprintBuilder {
     }
 }
 
-/// One converged (or capped) Algorithm 1 solve: what `scale_aware_ora` needs to stand in for it.
-pub(super) struct ConvergedSolve {
+/// One finished Algorithm 1 solve (converged or at its cap): what `scale_aware_ora` needs to stand
+/// in for it.
+pub(super) struct MemoizedSolve {
     /// The `#V x 3` result.
     pub positions: Vec<[f64; 3]>,
     pub summary: SolveSummary,
@@ -86,10 +87,10 @@ pub(super) struct ConvergedSolve {
     pub seconds: f64,
 }
 
-static SOLVES: Mutex<VecDeque<(Fingerprint, Arc<ConvergedSolve>)>> = Mutex::new(VecDeque::new());
+static SOLVES: Mutex<VecDeque<(Fingerprint, Arc<MemoizedSolve>)>> = Mutex::new(VecDeque::new());
 
 /// Keep `solve` under `key`, replacing an entry of the same key; the oldest entry goes when full.
-pub(super) fn store(key: Fingerprint, solve: ConvergedSolve) {
+pub(super) fn store(key: Fingerprint, solve: MemoizedSolve) {
     let mut solves = SOLVES.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     solves.retain(|(k, _)| *k != key);
     if solves.len() == CAPACITY {
@@ -99,7 +100,7 @@ pub(super) fn store(key: Fingerprint, solve: ConvergedSolve) {
 }
 
 /// The solve stored under `key`, if any.
-pub(super) fn find(key: Fingerprint) -> Option<Arc<ConvergedSolve>> {
+pub(super) fn find(key: Fingerprint) -> Option<Arc<MemoizedSolve>> {
     let solves = SOLVES.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     solves.iter().find(|(k, _)| *k == key).map(|(_, s)| Arc::clone(s))
 }
