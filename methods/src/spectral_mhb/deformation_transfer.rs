@@ -60,7 +60,9 @@ impl DeformationTransfer {
                 }
             }
         }
-        let cholesky = SparseCholesky::new(system.as_ref())?;
+        let mut cholesky = SparseCholesky::new(system.as_ref())?;
+        // Every RT2 solve has three columns: the blocked copy of the factor is all it reads.
+        cholesky.keep_only_solves();
         let gradients = triangles.iter().map(|t| hat_gradients(rest, t)).collect();
         let source_frames_inverse = triangles.iter().map(|t| invert(&frame(smoothed, t))).collect();
         Ok(Self {
