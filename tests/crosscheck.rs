@@ -172,7 +172,7 @@ impl ArapCase {
     fn our_arap(&self, iterations: usize) -> Vec<[f64; 3]> {
         // libigl's arap uses the mesh's cotangent weights.
         let params: toml::Table = format!(
-            "max_iterations = {iterations}\ntolerance = 0.0\nweights = \"cotan\"\nacceleration = \"none\""
+            "max_iterations = {iterations}\ntolerance = 0.0\nweights = \"cotan\"\nacceleration = \"none\"\nstart = \"current\""
         )
         .parse()
         .unwrap();
