@@ -447,7 +447,7 @@ fn peers_arap_agrees_with_open3d_arap() {
     }
 }
 
-/// open3d's `is_self_intersecting`: false on the four rest survey meshes, true on two triangles that
+/// open3d's `is_self_intersecting` through the harness's script (python/self_intersection.py): false on the four rest survey meshes, true on two triangles that
 /// cross, false on the same two moved apart. (open3d tests all pairs of triangles: 25 s of this test's
 /// ~28 s is the 80K-face plane.)
 #[test]
@@ -469,9 +469,8 @@ fn peers_open3d_self_intersection_flags_only_the_crossing_mesh() {
     let mut paths: Vec<std::path::PathBuf> = MESHES.iter().map(|n| dir.join(format!("{n}.off"))).collect();
     paths.push(crossing_path.clone());
     paths.push(apart_path.clone());
-    let mut args = vec!["self_intersecting"];
-    args.extend(paths.iter().map(|p| p.to_str().unwrap()));
-    let out = peers_reference(&py, &args);
+    let args: Vec<&str> = paths.iter().map(|p| p.to_str().unwrap()).collect();
+    let out = support::self_intersection_script(&py, &args);
     let verdicts: HashMap<String, bool> = out
         .lines()
         .map(|line| {

@@ -87,7 +87,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
                 assert!(v.is_finite() && v >= 0.0, "{scenario}/{method}: {key} = {v}");
             }
             // GLB by default; OFF only with `--mesh-format off|both`.
-            let stem = harness::report::case_file_stem(scenario, method);
+            let stem = harness::stored_report::case_file_stem(scenario, method);
             let glb = reports.path().join(format!("meshes/{stem}.glb"));
             let result = meshes::io::read_mesh(&glb).unwrap();
             assert_eq!(result.n_vertices(), row["vertices"].parse::<usize>().unwrap());
@@ -457,7 +457,7 @@ fn the_page_ranks_sorts_and_filters_as_its_address_asks_in_chromium() {
     assert_eq!(attribute(tag, "data-left"), Some("isolines"), "isolines on the left");
     // Every case with a result has its file; the page itself carries no mesh.
     for row in &rows {
-        let stem = harness::report::case_file_stem(&row["scenario"], &row["method"]);
+        let stem = harness::stored_report::case_file_stem(&row["scenario"], &row["method"]);
         assert!(reports.path().join(format!("viewer/{stem}.js")).is_file(), "viewer/{stem}.js");
     }
 }

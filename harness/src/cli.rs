@@ -5,17 +5,17 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use crate::case::CaseResult;
 use crate::comparison::ComparedRun;
 use crate::config::PeerSetup;
 use crate::metrics::METRICS;
-use crate::peers;
+use crate::paths::SURVEY_DIR_ENV;
 use crate::pipeline::{self, GateRequest, Outcome, PublishOptions};
+use crate::record::CaseResult;
 use crate::regression::{self, GateOutcome};
 use crate::report::{MeshFormat, MeshOutput};
 use crate::scenario::load_specs;
 use crate::shard::Shard;
-use crate::suite::{self, SuiteOptions, SURVEY_DIR_ENV};
+use crate::suite::{self, SuiteOptions};
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
 
@@ -176,14 +176,14 @@ impl Peers {
             None => Err(format!(
                 "peers not run: they need the cross-check Python with libigl and open3d; give --python or set {} \
                  (scripts/python-env sets it up and prints its path)",
-                peers::PYTHON_ENV
+                crate::paths::PYTHON_ENV
             )),
         })
     }
 
     /// `--python`, else `DEFORMBENCH_PYTHON` when set and not empty.
     fn python_path(&self) -> Option<PathBuf> {
-        self.python.clone().or_else(|| path_from_env(peers::PYTHON_ENV))
+        self.python.clone().or_else(|| path_from_env(crate::paths::PYTHON_ENV))
     }
 
     /// The Python to run the peer checks with, if they were asked for.
@@ -197,7 +197,7 @@ impl Peers {
             None => anyhow::bail!(
                 "--self-intersections needs the cross-check Python with open3d: give --python or set {} \
                  (scripts/python-env sets it up and prints its path)",
-                peers::PYTHON_ENV
+                crate::paths::PYTHON_ENV
             ),
         }
     }
@@ -272,7 +272,7 @@ impl Meshes {
 
 impl Common {
     fn options(&self, scenarios: Vec<String>, methods: Vec<String>, command_line: &[String]) -> SuiteOptions {
-        let root = suite::workspace_root();
+        let root = crate::paths::workspace_root();
         SuiteOptions {
             configs_dir: self.configs.clone().unwrap_or_else(|| root.join("configs")),
             scenarios_dir: self.scenarios.clone(),
@@ -289,7 +289,7 @@ impl Common {
             } else {
                 self.method_files.clone()
             },
-            python: path_from_env(peers::PYTHON_ENV),
+            python: path_from_env(crate::paths::PYTHON_ENV),
             threads: self
                 .threads
                 .map_or_else(|| crate::threads::default_threads(self.jobs as usize), |t| t as usize),
@@ -393,7 +393,7 @@ where
             );
             let (a, b) = (ComparedRun::read(&a)?, ComparedRun::read(&b)?);
             let comparison = crate::comparison::compare(&a, &b, min_change);
-            let out = out.unwrap_or_else(|| suite::workspace_root().join("reports/comparison"));
+            let out = out.unwrap_or_else(|| crate::paths::workspace_root().join("reports/comparison"));
             crate::report::write_comparison(&out, &comparison)
                 .with_context(|| format!("writing the comparison to {}", out.display()))?;
             // The warnings head the printed markdown.

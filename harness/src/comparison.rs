@@ -10,11 +10,11 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use crate::case::{CaseResult, TimedPhase};
 use crate::error::HarnessError;
 use crate::provenance::Provenance;
+use crate::record::{CaseResult, TimedPhase};
 use crate::regression::{self, Finding};
-use crate::report::{read_results, StoredReport};
+use crate::stored_report::{read_results, StoredReport};
 
 /// The default smallest change of a median that can be called slower or faster: 5%.
 pub const DEFAULT_MIN_CHANGE: f64 = 0.05;

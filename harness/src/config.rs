@@ -268,7 +268,7 @@ impl MethodCatalog {
     pub fn add_peers(&mut self, peers: &PeerSetup) -> Result<(), HarnessError> {
         let path = &peers.file;
         let python = peers.python.to_string_lossy();
-        let given = [(crate::peers::PYTHON_ENV, python.as_ref())];
+        let given = [(crate::paths::PYTHON_ENV, python.as_ref())];
         for (name, table) in read_tables(path)? {
             if self.methods.iter().any(|m| m.name == name) {
                 return Err(HarnessError::Config {

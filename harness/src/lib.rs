@@ -1,5 +1,22 @@
 //! The deformbench harness: scenarios and method parameters from `configs/`, running every method
 //! through its phases with timings, quality metrics, and reports in `reports/`.
+//!
+//! The modules form a stack: each imports only from its own layer or the layers below it, never
+//! from one above (`scripts/check-imports` checks this list against the code, with no circles).
+//! Top to bottom:
+//!
+//! ```text
+//! cli, method_check              the command line: parse, print, exit codes; `check-method`
+//! pipeline                       publish a run: reports, plots, figures, gate, the page, in one directory
+//! report/                        the files people read, from records: tables, plots, pictures, page
+//! comparison                     two stored runs compared, case by case
+//! suite                          load a run's inputs, schedule its cases (jobs, shards), merge parts
+//! case, self_intersection        run one case through its phases; open3d's check of a result
+//! stored_report, regression, pareto   records on disk (results.json), the gate, the fronts
+//! record, provenance             the run's record: what each case measured; where and how it ran
+//! config, scenario, shard, sweep, metrics, verdict   what a run is made of, measures, verdict rules
+//! paths, error, threads, variables, memory           the workspace, errors, threads, ${VAR}, RSS
+//! ```
 
 pub mod case;
 pub mod cli;
@@ -10,13 +27,16 @@ pub mod memory;
 pub mod method_check;
 pub mod metrics;
 pub mod pareto;
-pub mod peers;
+pub mod paths;
 pub mod pipeline;
 pub mod provenance;
+pub mod record;
 pub mod regression;
 pub mod report;
 pub mod scenario;
+pub mod self_intersection;
 pub mod shard;
+pub mod stored_report;
 pub mod suite;
 pub mod sweep;
 pub mod threads;

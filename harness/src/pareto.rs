@@ -6,8 +6,8 @@
 //! same with the precompute ([`TimeAxis::WithPrecompute`]); an external method's process start-up
 //! is left out of both, as it is out of `precompute_s`.
 
-use crate::case::CaseResult;
 use crate::metrics::Metric;
+use crate::record::CaseResult;
 
 /// The time budgets per edit of the budget table, in seconds.
 pub const BUDGETS_S: [f64; 5] = [1e-3, 1e-2, 1e-1, 1.0, 10.0];

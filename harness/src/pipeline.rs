@@ -5,12 +5,12 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::case::CaseResult;
 use crate::error::HarnessError;
+use crate::record::CaseResult;
 use crate::regression::{self, BaselineKind, GateOutcome};
 use crate::report::{self, html, peer_comparison, plots, render, MeshOutput};
-use crate::suite::{self, SuiteOptions, SuiteRun};
-use crate::{peers, shard::Shard};
+use crate::suite::{SuiteOptions, SuiteRun};
+use crate::{self_intersection, shard::Shard};
 
 /// Which baseline a run is compared with.
 #[derive(Clone, Debug, PartialEq)]
@@ -28,7 +28,7 @@ impl GateRequest {
     /// real-mesh suite `configs/real-meshes` or the dataset's smoke set `configs/dataset-smoke`);
     /// any other run is compared only with a baseline named on purpose.
     pub fn for_suite(options: &SuiteOptions, baseline: Option<PathBuf>) -> GateRequest {
-        let default_configs = suite::workspace_root().join("configs");
+        let default_configs = crate::paths::workspace_root().join("configs");
         let same = |a: &Path, b: &Path| {
             a.canonicalize().ok().zip(b.canonicalize().ok()).is_some_and(|(a, b)| a == b)
         };
@@ -56,7 +56,7 @@ impl GateRequest {
 pub fn baseline_path(baseline: Option<&Path>, results: &[CaseResult]) -> PathBuf {
     baseline
         .map(Path::to_path_buf)
-        .unwrap_or_else(|| BaselineKind::of(results).default_path(&suite::workspace_root()))
+        .unwrap_or_else(|| BaselineKind::of(results).default_path(&crate::paths::workspace_root()))
 }
 
 /// The work of a run after its cases, in the order [`publish`] does it; each is timed as a phase of
@@ -65,7 +65,7 @@ pub fn baseline_path(baseline: Option<&Path>, results: &[CaseResult]) -> PathBuf
 pub enum RunPhase {
     /// The methods' precompute, bind and solve, summed over the cases.
     Methods,
-    /// `E_theta` / `E_phi` of the iterates for the convergence curves ([`crate::case::records_quality`]).
+    /// `E_theta` / `E_phi` of the iterates for the convergence curves ([`crate::record::records_quality`]).
     TraceQuality,
     /// The quality measures of the final shapes.
     Evaluation,
@@ -153,7 +153,7 @@ pub fn publish(
 
     let start = Instant::now();
     if let Some(python) = &publish.peer_python {
-        let answers = peers::self_intersections(python, &run.results, &run.scenarios)
+        let answers = self_intersection::self_intersections(python, &run.results, &run.scenarios)
             .map_err(|e| HarnessError::Report(format!("self-intersection check (open3d): {e}")))?;
         for (r, answer) in run.results.iter_mut().zip(answers) {
             r.self_intersecting = answer;
@@ -252,7 +252,7 @@ pub fn publish_partial(options: &SuiteOptions, run: &SuiteRun, shard: Shard) -> 
 /// its data source). Errors: no results, no such baseline, or a baseline of other data.
 pub fn check(reports_dir: &Path, baseline: Option<&Path>) -> Result<GateOutcome, HarnessError> {
     let results_path = reports_dir.join("results.json");
-    let results = report::read_results(&results_path)?.cases;
+    let results = crate::stored_report::read_results(&results_path)?.cases;
     let path = baseline_path(baseline, &results);
     if !path.is_file() {
         return Err(HarnessError::Config { path, message: "no such baseline".into() });
@@ -266,7 +266,7 @@ pub fn check(reports_dir: &Path, baseline: Option<&Path>) -> Result<GateOutcome,
 /// Rewrite the baseline (`baseline`, or the committed one of the data source) from the
 /// `results.json` in `reports_dir`; returns the path written and the number of cases.
 pub fn write_baseline(reports_dir: &Path, baseline: Option<&Path>) -> Result<(PathBuf, usize), HarnessError> {
-    let results = report::read_results(&reports_dir.join("results.json"))?.cases;
+    let results = crate::stored_report::read_results(&reports_dir.join("results.json"))?.cases;
     let new = regression::baseline_from(&results);
     let path = baseline_path(baseline, &results);
     regression::write_baseline(&path, &new)?;

@@ -146,7 +146,7 @@ impl Machine {
 
 impl Build {
     fn read() -> Self {
-        let root = crate::suite::workspace_root();
+        let root = crate::paths::workspace_root();
         let git = |args: &[&str]| {
             std::process::Command::new("git")
                 .arg("-C")
@@ -180,7 +180,7 @@ pub struct ExternalRecord {
 }
 
 /// The `about` of every external method of `results`, once per method.
-pub fn external_records(results: &[crate::case::CaseResult]) -> Vec<ExternalRecord> {
+pub fn external_records(results: &[crate::record::CaseResult]) -> Vec<ExternalRecord> {
     let mut out: Vec<ExternalRecord> = Vec::new();
     for r in results.iter().filter(|r| r.origin != crate::config::Origin::BuiltIn) {
         if let Some(about) = &r.about {

@@ -13,9 +13,9 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::case::CaseResult;
 use crate::error::HarnessError;
 use crate::metrics::{Metric, METRICS};
+use crate::record::CaseResult;
 use crate::verdict::STATUS_KINDS;
 
 /// One (scenario, method) of the baseline.

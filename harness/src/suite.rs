@@ -7,30 +7,17 @@ use std::sync::OnceLock;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::case::{run_case, CaseResult, CaseSettings, Reference};
+use crate::case::{run_case, CaseSettings, Reference};
 use crate::config::{MethodCatalog, PeerSetup};
 use crate::error::HarnessError;
 use crate::metrics::RestGeometry;
 use crate::provenance::Provenance;
+use crate::record::{CaseResult, REFERENCE_METHOD};
 use crate::scenario::{
     load_spec, load_specs, DataSource, LoadedScenario, ScenarioSpec, SkippedInput, FILE_SOURCE,
 };
 use crate::shard::{assign, estimated_cost, Shard};
 use crate::verdict::VerdictRules;
-
-/// The method every other is compared with (`rms_to_arap_over_diag`, `max_to_arap_over_diag`).
-pub const REFERENCE_METHOD: &str = methods::registry::ARAP;
-
-/// The peer that runs the reference's energy to the same tolerance (configs/peers.toml): the page
-/// sets their times to convergence side by side.
-pub const PEER_OF_REFERENCE: &str = "libigl_arap";
-
-/// Our reference with the peer's weights (plain cotangents; configs/peers.toml), so the peer's
-/// shape can be checked against ours like for like.
-pub const LIKE_FOR_LIKE_REFERENCE: &str = "arap_cotan";
-
-/// Environment variable naming the survey data directory (same as `--survey-dir`).
-pub const SURVEY_DIR_ENV: &str = "DEFORM_SURVEY_DIR";
 
 /// Everything a run needs to know.
 #[derive(Clone, Debug)]
@@ -226,7 +213,7 @@ fn check_sweep_scenarios(
 /// The methods of a run: `methods.toml` of the configuration directory, and the peers if asked for.
 pub fn load_catalog(options: &SuiteOptions) -> Result<MethodCatalog, HarnessError> {
     let python = options.python.as_ref().map(|p| p.to_string_lossy().into_owned());
-    let given: Vec<(&str, &str)> = python.iter().map(|p| (crate::peers::PYTHON_ENV, p.as_str())).collect();
+    let given: Vec<(&str, &str)> = python.iter().map(|p| (crate::paths::PYTHON_ENV, p.as_str())).collect();
     let mut catalog = MethodCatalog::load_with(&options.configs_dir.join("methods.toml"), &given)?;
     for file in &options.method_files {
         catalog.add_method_file(file, &given)?;
@@ -534,7 +521,7 @@ impl SharedCases<'_> {
         let stderr_log = method.is_external().then(|| {
             self.options.reports_dir.join("logs").join(format!(
                 "{}.stderr.txt",
-                crate::report::case_file_stem(&scenario.spec.name, &method.name)
+                crate::stored_report::case_file_stem(&scenario.spec.name, &method.name)
             ))
         });
         run_case(
@@ -562,9 +549,13 @@ pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, Harne
     let mut parts: Vec<(Shard, PathBuf, Vec<CaseResult>)> = Vec::with_capacity(dirs.len());
     for dir in dirs {
         let path = dir.join("results.json");
-        let crate::report::StoredReport {
-            cases, data_source: their_source, shard, provenance: record, ..
-        } = crate::report::read_results(&path)?;
+        let crate::stored_report::StoredReport {
+            cases,
+            data_source: their_source,
+            shard,
+            provenance: record,
+            ..
+        } = crate::stored_report::read_results(&path)?;
         let config = |message: String| HarnessError::Config { path: path.clone(), message };
         let shard = shard.ok_or_else(|| config("not a partial report (written without --shard)".into()))?;
         if their_source != data_source {
@@ -607,9 +598,10 @@ pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, Harne
             };
             let order = plan[i].iter().position(|m| *m == case.method).unwrap_or(usize::MAX);
             if !case.status.is_failed() {
-                let mesh_path = dir
-                    .join("meshes")
-                    .join(format!("{}.off", crate::report::case_file_stem(&case.scenario, &case.method)));
+                let mesh_path = dir.join("meshes").join(format!(
+                    "{}.off",
+                    crate::stored_report::case_file_stem(&case.scenario, &case.method)
+                ));
                 let mesh = meshes::io::read_mesh(&mesh_path)?;
                 case.positions = Some(
                     scenarios[i]
@@ -653,10 +645,4 @@ fn describe_data(source: &DataSource, scenarios: &[LoadedScenario]) -> String {
             parts.join(", ")
         }
     }
-}
-
-/// The workspace root (configs/ and reports/ live there), from the harness crate's location.
-pub fn workspace_root() -> PathBuf {
-    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
-    root.canonicalize().unwrap_or_else(|_| root.to_path_buf())
 }

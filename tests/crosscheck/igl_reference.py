@@ -2,7 +2,7 @@
 """Reference results computed with libigl (and scipy) for deformbench's cross-check tests.
 
 The Rust tests run this script (with the interpreter named by $DEFORMBENCH_PYTHON, set up by
-scripts/python-env from tests/crosscheck/requirements.txt) and compare the Rust implementations
+scripts/python-env from python/requirements.txt) and compare the Rust implementations
 against its output. Every file written here is plain text, so the Rust side needs no extra crate
 to read it. Floats are written with '%.17g' (round-trips an f64 exactly).
 

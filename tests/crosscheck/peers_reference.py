@@ -2,7 +2,7 @@
 """Reference results computed with pymeshlab and open3d for deformbench's cross-check tests.
 
 The companion of igl_reference.py (libigl/scipy): the Rust tests run this script with the interpreter
-named by $DEFORMBENCH_PYTHON (set up by scripts/python-env from tests/crosscheck/requirements.txt) and
+named by $DEFORMBENCH_PYTHON (set up by scripts/python-env from python/requirements.txt) and
 compare against its output. Files are plain text; floats are written with '%.17g' (round-trips an f64).
 
 Mesh input is a triangle OFF file. pymeshlab subcommands load it with pymeshlab's own loader
@@ -62,10 +62,8 @@ geometric_measures MESH
     {"surface_area": ..., "mesh_volume": ... or null}; MeshLab reports a volume only for a watertight
     mesh (the divergence theorem over the faces; signed, positive when the faces face outwards).
 
-self_intersecting MESH [MESH ...]
-    open3d TriangleMesh.is_self_intersecting() for each mesh; prints one CSV line per mesh,
-    `path,true` or `path,false`. open3d uses no spatial index here; measured about 1 s for the 10K-face
-    survey meshes and 25 s for the 80K-face plane.
+(open3d's is_self_intersecting is the harness's own check, python/self_intersection.py; measured
+about 1 s for the 10K-face survey meshes and 25 s for the 80K-face plane.)
 
 Errors go to stderr naming the file, with exit code 1. Nothing else is printed on stdout.
 """
@@ -291,15 +289,6 @@ def cmd_open3d_arap(args):
     write_off(args.out, U, F)
 
 
-def cmd_self_intersecting(args):
-    lines = []
-    for path in args.meshes:
-        V, F = read_off(path)
-        hit = open3d_mesh(V, F).is_self_intersecting()
-        lines.append(f"{path},{'true' if hit else 'false'}")
-    print("\n".join(lines))
-
-
 # ---------------------------------------------------------------------------------------------
 
 
@@ -330,9 +319,6 @@ def build_parser():
     s.add_argument("--iterations", type=positive_int, required=True)
     s.set_defaults(func=cmd_open3d_arap, needs=import_open3d)
 
-    s = sub.add_parser("self_intersecting", help="open3d is_self_intersecting per mesh, as CSV")
-    s.add_argument("meshes", nargs="+", metavar="mesh")
-    s.set_defaults(func=cmd_self_intersecting, needs=import_open3d)
     return p
 
 

@@ -91,6 +91,15 @@ pub fn peers_reference(python: &Path, args: &[&str]) -> String {
     run_script(python, "peers_reference.py", args)
 }
 
+/// Run the harness's self-intersection check `python/self_intersection.py` on `meshes`; panics with
+/// its stderr on failure. Returns stdout (`path,true|false` per mesh).
+pub fn self_intersection_script(python: &Path, meshes: &[&str]) -> String {
+    let path = workspace_root().join("python/self_intersection.py");
+    let out = Command::new(python).arg(&path).args(meshes).output().expect("run python");
+    assert!(out.status.success(), "self_intersection.py failed:\n{}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8(out.stdout).expect("utf-8")
+}
+
 /// Run the cross-check script `tests/crosscheck/<script>` with `args`; panics with its stderr on
 /// failure. Returns stdout.
 fn run_script(python: &Path, script: &str, args: &[&str]) -> String {

@@ -14,9 +14,9 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use crate::case::CaseResult;
 use crate::metrics::{percentile, Metric};
 use crate::pareto::TimeAxis;
+use crate::record::CaseResult;
 use crate::scenario::SkippedInput;
 use crate::verdict::{reason_kind, REASON_KINDS, STATUS_KINDS};
 

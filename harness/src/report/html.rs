@@ -9,10 +9,10 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::case::CaseResult;
 use crate::config::Origin;
 use crate::error::HarnessError;
 use crate::metrics::METRICS;
+use crate::record::CaseResult;
 use crate::regression::GateOutcome;
 
 /// Escape text for HTML element content and attribute values.
@@ -209,12 +209,12 @@ pub fn render_index(
             escape(&r.mesh_source),
             member_attributes(r),
             {
-                let stem = crate::report::case_file_stem(&r.scenario, &r.method);
+                let stem = crate::stored_report::case_file_stem(&r.scenario, &r.method);
                 if viewable.contains(&stem) {
                     format!(
                         " data-view=\"{}\" data-rest=\"{}.rest\"",
                         escape(&stem),
-                        escape(&crate::report::file_name(&r.scenario))
+                        escape(&crate::stored_report::file_name(&r.scenario))
                     )
                 } else {
                     String::new()
@@ -417,7 +417,7 @@ fn quality_against_time(page: &mut String, results: &[CaseResult], plots: &[&Pat
 
 /// A timing cell (`<td>`, sorted by its value): the value, and below it the min–max range when it
 /// is a median of repetitions.
-fn timing(value: f64, spread: Option<(usize, crate::case::Spread)>, digits: usize) -> String {
+fn timing(value: f64, spread: Option<(usize, crate::record::Spread)>, digits: usize) -> String {
     let text = match spread {
         Some((n, s)) if n > 1 => format!(
             "{}<br><small title=\"min–max over {n} repetitions\">{}–{}</small>",

@@ -16,21 +16,3 @@ pub mod tables;
 pub mod viewer;
 
 pub use tables::*;
-
-/// `name` with every character other than ASCII letters, digits, `-`, `_` and `.` replaced by `_`,
-/// so it is one file name on every system.
-pub fn file_name(name: &str) -> String {
-    let cleaned: String =
-        name.chars().map(|c| if c.is_ascii_alphanumeric() || "-_.".contains(c) { c } else { '_' }).collect();
-    if cleaned.is_empty() || cleaned.chars().all(|c| c == '.') {
-        format!("_{cleaned}")
-    } else {
-        cleaned
-    }
-}
-
-/// The file stem of a case's files (`meshes/`, stderr logs): `<scenario>-<method>`, [`file_name`]d,
-/// so a sweep point's `isolines[isolines=10]` becomes `isolines_isolines_10_`.
-pub fn case_file_stem(scenario: &str, method: &str) -> String {
-    format!("{}-{}", file_name(scenario), file_name(method))
-}

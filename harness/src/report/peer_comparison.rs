@@ -7,9 +7,9 @@
 
 use std::fmt::Write as _;
 
-use crate::case::CaseResult;
+use crate::record::CaseResult;
+use crate::record::{LIKE_FOR_LIKE_REFERENCE, PEER_OF_REFERENCE, REFERENCE_METHOD};
 use crate::scenario::LoadedScenario;
-use crate::suite::{LIKE_FOR_LIKE_REFERENCE, PEER_OF_REFERENCE, REFERENCE_METHOD};
 
 /// One of our ARAP rows set against libigl's on one test.
 #[derive(Clone, Debug, PartialEq)]

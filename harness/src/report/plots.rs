@@ -22,9 +22,9 @@ use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::case::CaseResult;
 use crate::error::HarnessError;
 use crate::metrics::{MetricSpec, METRICS};
+use crate::record::CaseResult;
 
 /// Pixel size of every plot but the errors plot.
 const SIZE: (u32, u32) = (960, 540);
@@ -427,7 +427,7 @@ fn draw_convergence<DB: DrawingBackend>(
     // Log x axis over iteration + 1: the unreduced methods take 1000+ iterations, the reduced ones
     // and scale_aware tens, and both ends must be readable.
     let max_iter = cases.iter().map(|c| c.trace.len()).max().unwrap_or(1).max(2) as f64 + 1.0;
-    type Series = fn(&crate::case::IterationRecord) -> Option<f64>;
+    type Series = fn(&crate::record::IterationRecord) -> Option<f64>;
     let specs: [(&str, Series, bool); 3] = [
         ("step / diagonal", |t| Some(t.step), true),
         ("E_θ (degrees)", |t| t.e_theta_deg, false),

@@ -6,8 +6,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::case::CaseResult;
 use crate::pareto::{best_within, budget_label, ok_front, points, TimeAxis, BUDGETS_S, MEASURES};
+use crate::record::CaseResult;
 
 /// The fewest settings of one sweep on a test that make it a swept test: a trade-off needs a line,
 /// and `isolines[isolines=10]` beside `isolines` in every run is not a sweep run.

@@ -41,7 +41,7 @@ fn ratio_text(r: f64) -> String {
 fn phase_notes(c: &CaseChange) -> String {
     c.phases
         .iter()
-        .filter(|p| p.phase != crate::case::TimedPhase::Total)
+        .filter(|p| p.phase != crate::record::TimedPhase::Total)
         .filter(|p| matches!(p.speed, Speed::Slower | Speed::Faster))
         .map(|p| format!("{} {} ({:.2}x)", p.phase.label(), p.speed.label(), p.ratio))
         .collect::<Vec<_>>()

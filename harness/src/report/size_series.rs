@@ -9,7 +9,7 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use crate::case::CaseResult;
+use crate::record::CaseResult;
 use crate::scenario::LoadedScenario;
 
 /// The quantities whose growth with #V is fitted, with how each reads off a case.

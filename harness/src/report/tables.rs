@@ -5,12 +5,10 @@
 
 use std::path::Path;
 
-use serde::Serialize;
-
-use crate::case::CaseResult;
 use crate::error::HarnessError;
 use crate::metrics::METRICS;
 use crate::provenance::Provenance;
+use crate::record::CaseResult;
 use crate::scenario::{LoadedScenario, SkippedInput};
 use crate::shard::Shard;
 
@@ -60,61 +58,6 @@ pub fn csv_columns() -> Vec<&'static str> {
         .chain(METRICS.iter().map(|s| s.key))
         .chain(VERDICT_COLUMNS.iter().copied())
         .collect()
-}
-
-#[derive(Serialize)]
-struct JsonReport<'a> {
-    generator: &'static str,
-    data_source: &'a str,
-    /// `K/N` in a partial report of `all --shard K/N`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    shard: Option<String>,
-    units: &'static str,
-    provenance: &'a Provenance,
-    cases: &'a [CaseResult],
-    /// Meshes of collections no case ran on, with the reason.
-    #[serde(skip_serializing_if = "<[_]>::is_empty")]
-    skipped: &'a [SkippedInput],
-}
-
-/// A `results.json` read back.
-pub struct StoredReport {
-    pub cases: Vec<CaseResult>,
-    pub data_source: String,
-    /// The part, for a partial report.
-    pub shard: Option<Shard>,
-    /// Where and how it was made (none in a report of an older harness).
-    pub provenance: Option<Provenance>,
-    /// Meshes of collections no case ran on.
-    pub skipped: Vec<SkippedInput>,
-}
-
-/// Read a `results.json` written by a run (or a shard of one).
-pub fn read_results(path: &Path) -> Result<StoredReport, HarnessError> {
-    #[derive(serde::Deserialize)]
-    struct Stored {
-        data_source: String,
-        #[serde(default)]
-        shard: Option<String>,
-        #[serde(default)]
-        provenance: Option<Provenance>,
-        cases: Vec<CaseResult>,
-        #[serde(default)]
-        skipped: Vec<SkippedInput>,
-    }
-    let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
-    let text = std::fs::read(path).map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
-    let stored: Stored = serde_json::from_slice(&text)
-        .map_err(|e| config(format!("not a results.json of this harness: {e}")))?;
-    let shard =
-        stored.shard.map(|s| s.parse::<Shard>()).transpose().map_err(|e| config(format!("shard: {e}")))?;
-    Ok(StoredReport {
-        cases: stored.cases,
-        data_source: stored.data_source,
-        shard,
-        provenance: stored.provenance,
-        skipped: stored.skipped,
-    })
 }
 
 /// A CSV number: empty for NaN (a missing value), else 7 significant digits.
@@ -174,28 +117,6 @@ pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
         w.write_record(row).map_err(err)?;
     }
     w.into_inner().map_err(|e| HarnessError::Report(format!("CSV: {e}")))
-}
-
-/// `results.json` contents: every CSV column plus method phase timings and per-iteration traces
-/// (and the part, for a partial report).
-pub fn render_json(
-    results: &[CaseResult],
-    data_source: &str,
-    provenance: &Provenance,
-    skipped: &[SkippedInput],
-    shard: Option<Shard>,
-) -> Result<Vec<u8>, HarnessError> {
-    let report = JsonReport {
-        generator: concat!("deformbench harness ", env!("CARGO_PKG_VERSION")),
-        data_source,
-        shard: shard.map(|s| s.to_string()),
-        units: "times in seconds (median_iteration_ms in milliseconds); angles in degrees; *_over_diag relative to the rest bounding-box diagonal; e_area, e_length RMS log ratios; volume_change and folds fractions",
-        provenance,
-        cases: results,
-        skipped,
-    };
-    // NaN is not JSON: serde_json writes it as null, which is what a missing value should be.
-    serde_json::to_vec_pretty(&report).map_err(|e| HarnessError::Report(format!("JSON: {e}")))
 }
 
 /// Columns of `handle_updates.csv`: one row per (scenario, method, edit step).
@@ -295,7 +216,7 @@ pub fn render_table1(results: &[CaseResult]) -> String {
 
 /// `convergence.csv` contents: one row per iteration of every case (the scale-aware paper's Fig. 6
 /// curves), with the angle errors where the harness evaluated them (see
-/// [`crate::case::records_quality`]; empty otherwise).
+/// [`crate::record::records_quality`]; empty otherwise).
 pub fn render_convergence(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let err = |e: csv::Error| HarnessError::Report(format!("CSV: {e}"));
@@ -373,7 +294,7 @@ pub fn write_reports(
     meshes: &MeshOutput,
 ) -> Result<(), HarnessError> {
     let csv = render_csv(results)?;
-    let json = render_json(results, data_source, provenance, skipped, None)?;
+    let json = crate::stored_report::render_json(results, data_source, provenance, skipped, None)?;
     write_meshes(dir, results, scenarios, meshes)?;
     write_bytes(&dir.join("convergence.csv"), &render_convergence(results)?)?;
     write_bytes(&dir.join("handle_updates.csv"), &render_handle_updates(results)?)?;
@@ -397,7 +318,7 @@ pub fn write_partial(
     skipped: &[SkippedInput],
     shard: Shard,
 ) -> Result<(), HarnessError> {
-    let json = render_json(results, data_source, provenance, skipped, Some(shard))?;
+    let json = crate::stored_report::render_json(results, data_source, provenance, skipped, Some(shard))?;
     let every_mesh = MeshOutput { format: MeshFormat::Off, every_scenario: true };
     write_meshes(dir, results, scenarios, &every_mesh)?;
     write_bytes(&dir.join("results.json"), &json)
@@ -424,7 +345,7 @@ fn write_meshes(
         }
         // In the input file's vertex order, so per-vertex data of the input still applies.
         let mesh = scenario.in_input_order(positions)?;
-        let stem = super::case_file_stem(&r.scenario, &r.method);
+        let stem = crate::stored_report::case_file_stem(&r.scenario, &r.method);
         if output.format.writes_off() {
             meshes::io::write_off(mesh_dir.join(format!("{stem}.off")), &mesh)?;
         }

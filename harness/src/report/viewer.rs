@@ -12,8 +12,8 @@
 
 use std::path::Path;
 
-use crate::case::CaseResult;
 use crate::error::HarnessError;
+use crate::record::CaseResult;
 use crate::scenario::{LoadedScenario, Role};
 
 /// Where the viewer's files go, relative to the report directory.
@@ -80,7 +80,7 @@ pub fn write_viewer_data(
             .flatten()
             .flat_map(|&i| if short { (i as u16).to_le_bytes().to_vec() } else { i.to_le_bytes().to_vec() })
             .collect();
-        let rest_name = crate::report::file_name(&scenario.spec.name);
+        let rest_name = crate::stored_report::file_name(&scenario.spec.name);
         let mut fields = quantized(mesh.positions());
         fields.push(("triangles", format!("\"{}\"", base64::encode(triangles))));
         fields.push(("index_bytes", if short { "2" } else { "4" }.to_string()));
@@ -88,7 +88,7 @@ pub fn write_viewer_data(
         let text = script(&format!("{rest_name}.rest"), &fields);
         write(&out.join(format!("{rest_name}.rest.js")), &text)?;
         for case in cases {
-            let stem = crate::report::case_file_stem(&case.scenario, &case.method);
+            let stem = crate::stored_report::case_file_stem(&case.scenario, &case.method);
             let positions = case.positions.as_ref().expect("filtered");
             write(&out.join(format!("{stem}.js")), &script(&stem, &quantized(positions)))?;
             written.push(stem);

@@ -18,8 +18,6 @@ pub use mass::{corner_areas, lumped_mass, MassKind};
 
 use faer::sparse::SparseColMat;
 
-use crate::error::MethodError;
-
 /// Faces whose doubled area is below this fraction of their longest squared edge carry no
 /// cotangent or mass: a zero-area triangle has no angles, and letting it in would put `inf`/NaN
 /// into the operators. Valid survey meshes have ratios above 1e-2; the harness rejects degenerate
@@ -72,7 +70,7 @@ pub fn laplacian(
     weights: LaplacianWeights,
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
-) -> Result<SparseColMat<usize, f64>, MethodError> {
+) -> Result<SparseColMat<usize, f64>, IntrinsicDelaunayError> {
     Ok(match weights {
         LaplacianWeights::Cotan => cotan_laplacian(positions, triangles),
         LaplacianWeights::Clamped => clamped_cotan_laplacian(positions, triangles),
@@ -99,7 +97,7 @@ pub fn lumped_mass_for(
     positions: &[[f64; 3]],
     triangles: &[[u32; 3]],
     kind: MassKind,
-) -> Result<Vec<f64>, MethodError> {
+) -> Result<Vec<f64>, IntrinsicDelaunayError> {
     Ok(match weights {
         LaplacianWeights::Cotan | LaplacianWeights::Clamped => lumped_mass(positions, triangles, kind),
         LaplacianWeights::IntrinsicDelaunay => {

@@ -17,9 +17,9 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use crate::case::CaseResult;
 use crate::error::HarnessError;
 use crate::metrics::Metric;
+use crate::record::CaseResult;
 use crate::scenario::{LoadedScenario, Role};
 
 use super::camera::{Camera, VIEW_FROM};
@@ -100,11 +100,11 @@ pub fn write_figures(
     std::fs::create_dir_all(&figures).map_err(|error| HarnessError::Io { path: figures.clone(), error })?;
     let mut files: Vec<(PathBuf, &RgbImage)> = Vec::new();
     for (row, images) in rows.iter().zip(&rendered) {
-        let stem = crate::report::file_name(&row.scenario.spec.name);
+        let stem = crate::stored_report::file_name(&row.scenario.spec.name);
         files.push((Path::new(FIGURES).join(format!("{stem}-rest.png")), &images.rest));
         for (case, cell) in row.cases.iter().zip(&images.cells) {
             if let (Some(case), Cell::Rendered { shaded, heat, area, .. }) = (case, cell) {
-                let stem = format!("{stem}-{}", crate::report::file_name(&case.method));
+                let stem = format!("{stem}-{}", crate::stored_report::file_name(&case.method));
                 files.push((Path::new(FIGURES).join(format!("{stem}.png")), shaded));
                 files.push((Path::new(FIGURES).join(format!("{stem}-heat.png")), heat));
                 files.push((Path::new(FIGURES).join(format!("{stem}-area.png")), area));
@@ -125,8 +125,8 @@ pub fn write_figures(
         })
         .collect::<Result<Vec<_>, _>>()?;
     for (family, (sheet_rows, sheet_rendered)) in worst_sheets(results, &rows, &rendered) {
-        let name = format!("worst-{}.png", crate::report::file_name(&family));
-        let columns = ["result".to_string(), crate::suite::REFERENCE_METHOD.to_string()];
+        let name = format!("worst-{}.png", crate::stored_report::file_name(&family));
+        let columns = ["result".to_string(), crate::record::REFERENCE_METHOD.to_string()];
         let image = grid_image(&sheet_rows, &sheet_rendered, &columns, Kind::Shaded)
             .map_err(|e| HarnessError::Report(format!("{}: {e}", figures.join(&name).display())))?;
         grids.push((name, image));
@@ -167,7 +167,7 @@ fn worst_sheets<'a>(
     let cases = crate::report::dataset::dataset_cases(results);
     let mut sheets: Vec<(String, (Vec<Row>, Vec<RenderedRow>))> = Vec::new();
     for (family, method, worst) in crate::report::dataset::worst_ok(&cases) {
-        if method == crate::suite::REFERENCE_METHOD {
+        if method == crate::record::REFERENCE_METHOD {
             continue;
         }
         if sheets.last().is_none_or(|(f, _)| *f != family) {
@@ -184,7 +184,7 @@ fn worst_sheets<'a>(
                     .map(|k| (rows[i].cases[k], rendered[i].cells[k].clone()))
             };
             let (Some((result, result_cell)), reference) =
-                (cell_of(&method), cell_of(crate::suite::REFERENCE_METHOD))
+                (cell_of(&method), cell_of(crate::record::REFERENCE_METHOD))
             else {
                 continue;
             };
@@ -850,9 +850,9 @@ mod tests {
 
     #[test]
     fn file_names_keep_safe_characters_only() {
-        assert_eq!(crate::report::file_name("bar-sweep_6k.v2"), "bar-sweep_6k.v2");
-        assert_eq!(crate::report::file_name("a/b c\\d"), "a_b_c_d");
-        assert_eq!(crate::report::file_name(".."), "_..");
-        assert_eq!(crate::report::file_name(""), "_");
+        assert_eq!(crate::stored_report::file_name("bar-sweep_6k.v2"), "bar-sweep_6k.v2");
+        assert_eq!(crate::stored_report::file_name("a/b c\\d"), "a_b_c_d");
+        assert_eq!(crate::stored_report::file_name(".."), "_..");
+        assert_eq!(crate::stored_report::file_name(""), "_");
     }
 }

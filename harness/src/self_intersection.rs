@@ -1,25 +1,21 @@
-//! Checks of the results by a peer library: open3d's `TriangleMesh.is_self_intersecting` on every
-//! result, through `tests/crosscheck/peers_reference.py` (the pinned cross-check venv, see
-//! `scripts/python-env`). Opt-in (`--self-intersections`): open3d's test is quadratic-ish in the
+//! The self-intersection check of the results: open3d's `TriangleMesh.is_self_intersecting` on every
+//! result, through `python/self_intersection.py` (the project's venv, see `scripts/python-env`). Opt-in (`--self-intersections`): open3d's test is quadratic-ish in the
 //! face count, about 25 s per result on the 80K-face bumpy plane.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::case::CaseResult;
 use crate::error::HarnessError;
+use crate::record::CaseResult;
 use crate::scenario::LoadedScenario;
 
 /// Results with more faces are not checked (left empty): open3d's test took over 15 minutes on the
 /// 400K-face bar of the `bar-sweep-200k` scenario without finishing.
 pub const MAX_FACES: usize = 100_000;
 
-/// Environment variable naming the cross-check Python (set by `scripts/test`).
-pub const PYTHON_ENV: &str = "DEFORMBENCH_PYTHON";
-
-/// The peer script, in the workspace.
+/// The check's script, in the workspace.
 fn script() -> PathBuf {
-    crate::suite::workspace_root().join("tests/crosscheck/peers_reference.py")
+    crate::paths::python_dir().join("self_intersection.py")
 }
 
 /// `is_self_intersecting` of every case of `results` that has a result with at most [`MAX_FACES`]
@@ -29,7 +25,7 @@ pub fn self_intersections(
     results: &[CaseResult],
     scenarios: &[LoadedScenario],
 ) -> Result<Vec<Option<bool>>, HarnessError> {
-    let dir = std::env::temp_dir().join(format!("deformbench-peers-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("deformbench-self-intersection-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|error| HarnessError::Io { path: dir.clone(), error })?;
     let outcome = (|| {
         let mut files: Vec<(usize, PathBuf)> = Vec::new();
@@ -58,7 +54,6 @@ pub fn self_intersections(
             .map(|half| {
                 Command::new(python)
                     .arg(script())
-                    .arg("self_intersecting")
                     .args(half.iter())
                     .stdout(std::process::Stdio::piped())
                     .stderr(std::process::Stdio::piped())
@@ -73,7 +68,7 @@ pub fn self_intersections(
                 .map_err(|error| HarnessError::Io { path: python.to_path_buf(), error })?;
             if !out.status.success() {
                 return Err(HarnessError::Report(format!(
-                    "{} self_intersecting failed: {}",
+                    "{} failed: {}",
                     script().display(),
                     String::from_utf8_lossy(&out.stderr).trim()
                 )));
