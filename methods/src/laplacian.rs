@@ -41,7 +41,8 @@ use crate::laplacian_coordinates::{DeltaFrame, RotationInvariantCoordinates};
 use crate::linalg::anderson::{Acceleration, FixedPointIteration, MAX_DEPTH};
 use crate::linalg::sparse_cholesky::{add_to_diagonal, SparseCholesky};
 use crate::method::{
-    move_to, run_iterations, DeformationMethod, IterationObserver, Iterations, SolveSummary,
+    move_to, require_phase, run_iterations, DeformationMethod, IterationObserver, Iterations, Phase,
+    SolveSummary,
 };
 use crate::operators::{laplacian, LaplacianWeights};
 
@@ -181,13 +182,8 @@ impl DeformationMethod for LaplacianEditing {
     }
 
     fn bind_handles(&mut self, handles: &HandleSet) -> Result<(), MethodError> {
-        let (Some(rest), Some(cholesky)) = (&self.rest, &mut self.cholesky) else {
-            return Err(MethodError::Phase {
-                method: "laplacian",
-                phase: "bind_handles",
-                missing: "precompute",
-            });
-        };
+        let (rest, cholesky) =
+            require_phase(self.rest.as_ref().zip(self.cholesky.as_mut()), "laplacian", Phase::BindHandles)?;
         handles.check_mesh_size(self.current.len())?;
         let mut diagonal = vec![0.0; self.current.len()];
         let w2 = self.params.omega * self.params.omega;
@@ -204,9 +200,7 @@ impl DeformationMethod for LaplacianEditing {
         targets: &HandleTargets,
         observer: &mut dyn IterationObserver,
     ) -> Result<SolveSummary, MethodError> {
-        let Some(handles) = &self.handles else {
-            return Err(MethodError::Phase { method: "laplacian", phase: "solve", missing: "bind_handles" });
-        };
+        let handles = require_phase(self.handles.as_ref(), "laplacian", Phase::Solve)?;
         targets.check_for(handles)?;
         let w2 = self.params.omega * self.params.omega;
         let tolerance = self.params.tolerance;

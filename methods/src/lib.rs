@@ -22,5 +22,6 @@ pub mod spectral_mhb;
 pub use error::MethodError;
 pub use handles::{HandleRegion, HandleSet, HandleTargets};
 pub use method::{
-    DeformationMethod, IterationObserver, IterationReport, NoObserver, ReusedSolve, SolveSummary,
+    require_phase, DeformationMethod, IterationObserver, IterationReport, NoObserver, Phase, ReusedSolve,
+    SolveSummary,
 };

@@ -132,6 +132,45 @@ pub trait DeformationMethod: Send {
     }
 }
 
+/// The phases of a [`DeformationMethod`], in the order they are first called.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    Precompute,
+    BindHandles,
+    Solve,
+}
+
+impl Phase {
+    /// The trait method's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::Precompute => "precompute",
+            Phase::BindHandles => "bind_handles",
+            Phase::Solve => "solve",
+        }
+    }
+
+    /// The phase that must have run before this one (none before `precompute`).
+    pub fn needs(self) -> Option<Phase> {
+        match self {
+            Phase::Precompute => None,
+            Phase::BindHandles => Some(Phase::Precompute),
+            Phase::Solve => Some(Phase::BindHandles),
+        }
+    }
+}
+
+/// The phase guard every method opens `bind_handles` and `solve` with: `state` (what `phase` needs
+/// from the phase before it, `None` until that phase ran) or [`MethodError::Phase`] naming `method`,
+/// `phase` and the phase it needs.
+pub fn require_phase<T>(state: Option<T>, method: &'static str, phase: Phase) -> Result<T, MethodError> {
+    state.ok_or(MethodError::Phase {
+        method,
+        phase: phase.name(),
+        missing: phase.needs().map_or("nothing", Phase::name),
+    })
+}
+
 /// Phase timings or statistics under their `&'static` keys ([`crate::keys`]) as the trait reports them.
 pub(crate) fn owned_names(list: Vec<(&'static str, f64)>) -> Vec<(String, f64)> {
     list.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
@@ -211,4 +250,18 @@ pub(crate) fn move_to(
         *x = new;
     }
     Ok(step2.sqrt())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_phase_guard_names_the_method_the_phase_and_the_phase_it_needs() {
+        assert_eq!(require_phase(Some(3), "arap", Phase::Solve).unwrap(), 3);
+        let error = require_phase::<()>(None, "arap", Phase::Solve).unwrap_err();
+        assert_eq!(error.to_string(), "`arap`: solve called before bind_handles");
+        let error = require_phase::<()>(None, "hirm", Phase::BindHandles).unwrap_err();
+        assert_eq!(error.to_string(), "`hirm`: bind_handles called before precompute");
+    }
 }

@@ -61,7 +61,8 @@ use crate::handles::{HandleSet, HandleTargets, FREE};
 use crate::linalg::anderson::{Acceleration, AndersonAcceleration, RESIDUAL_GROWTH_LIMIT};
 use crate::linalg::sparse_cholesky::SparseCholesky;
 use crate::method::{
-    move_to, run_iterations, DeformationMethod, IterationObserver, Iterations, SolveSummary,
+    move_to, require_phase, run_iterations, DeformationMethod, IterationObserver, Iterations, Phase,
+    SolveSummary,
 };
 use crate::operators::{laplacian, LaplacianWeights};
 use crate::rotation_fit::{closest_rotation_warm, Mat3};
@@ -312,9 +313,8 @@ impl DeformationMethod for Arap {
     }
 
     fn bind_handles(&mut self, handles: &HandleSet) -> Result<(), MethodError> {
-        let (Some(stiffness), Some(cholesky)) = (&self.stiffness, &mut self.cholesky) else {
-            return Err(MethodError::Phase { method: "arap", phase: "bind_handles", missing: "precompute" });
-        };
+        let (stiffness, cholesky) =
+            require_phase(self.stiffness.as_ref().zip(self.cholesky.as_mut()), "arap", Phase::BindHandles)?;
         handles.check_mesh_size(self.rest.len())?;
         // Constrained rows and columns become identity; the pattern stays that of -L.
         let region_of = handles.region_of();
@@ -349,10 +349,11 @@ impl DeformationMethod for Arap {
         targets: &HandleTargets,
         observer: &mut dyn IterationObserver,
     ) -> Result<SolveSummary, MethodError> {
-        let (Some(handles), Some(spokes), Some(cholesky)) = (&self.handles, &self.spokes, &mut self.cholesky)
-        else {
-            return Err(MethodError::Phase { method: "arap", phase: "solve", missing: "bind_handles" });
-        };
+        let ((handles, spokes), cholesky) = require_phase(
+            self.handles.as_ref().zip(self.spokes.as_ref()).zip(self.cholesky.as_mut()),
+            "arap",
+            Phase::Solve,
+        )?;
         targets.check_for(handles)?;
         for (v, t) in handles.constrained().zip(targets.positions()) {
             self.current[v as usize] = *t;

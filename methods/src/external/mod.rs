@@ -20,7 +20,9 @@ use meshes::TriMesh;
 
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
-use crate::method::{DeformationMethod, IterationObserver, IterationReport, SolveSummary};
+use crate::method::{
+    require_phase, DeformationMethod, IterationObserver, IterationReport, Phase, SolveSummary,
+};
 use process::MethodProcess;
 use protocol::{Answer, Request};
 
@@ -200,13 +202,7 @@ impl DeformationMethod for ExternalMethod {
     }
 
     fn bind_handles(&mut self, handles: &HandleSet) -> Result<(), MethodError> {
-        if self.current.is_empty() {
-            return Err(MethodError::Phase {
-                method: "external",
-                phase: "bind_handles",
-                missing: "precompute",
-            });
-        }
+        require_phase((!self.current.is_empty()).then_some(()), "external", Phase::BindHandles)?;
         handles.check_mesh_size(self.n_vertices)?;
         let regions: Vec<&[u32]> = handles.regions().iter().map(|r| &r.vertices[..]).collect();
         self.call("bind", &Request::Bind { regions })?;

@@ -104,7 +104,9 @@ use crate::isoline_model::{
     ReducedIteration, RotationFit,
 };
 use crate::linalg::anderson::{Acceleration, MAX_DEPTH};
-use crate::method::{run_iterations, DeformationMethod, IterationObserver, Iterations, SolveSummary};
+use crate::method::{
+    require_phase, run_iterations, DeformationMethod, IterationObserver, Iterations, Phase, SolveSummary,
+};
 use crate::operators::{laplacian, lumped_mass_for, LaplacianWeights, MassKind};
 
 /// Parameters of [`Hirm`] (configs/methods.toml, section `[hirm]`).
@@ -391,9 +393,7 @@ impl DeformationMethod for Hirm {
     }
 
     fn bind_handles(&mut self, handles: &HandleSet) -> Result<(), MethodError> {
-        if self.rest.is_none() {
-            return Err(MethodError::Phase { method: "hirm", phase: "bind_handles", missing: "precompute" });
-        }
+        require_phase(self.rest.as_ref(), "hirm", Phase::BindHandles)?;
         handles.check_mesh_size(self.current.len())?;
         let needed = self.fields_needed(handles.regions().len());
         if self.rest.as_ref().is_some_and(|r| r.scores.len() < needed) {
@@ -462,9 +462,7 @@ impl DeformationMethod for Hirm {
         targets: &HandleTargets,
         observer: &mut dyn IterationObserver,
     ) -> Result<SolveSummary, MethodError> {
-        let (Some(rest), Some(bound)) = (&self.rest, &self.bound) else {
-            return Err(MethodError::Phase { method: "hirm", phase: "solve", missing: "bind_handles" });
-        };
+        let (rest, bound) = require_phase(self.rest.as_ref().zip(self.bound.as_ref()), "hirm", Phase::Solve)?;
         targets.check_for(&bound.handles)?;
         let (model, system) = (&bound.independent.model, &bound.independent.system);
         let t0 = Instant::now();

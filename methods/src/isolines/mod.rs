@@ -66,7 +66,9 @@ use crate::isoline_model::{
 };
 use crate::laplacian_coordinates::{DeltaFrame, RotationInvariantCoordinates};
 use crate::linalg::anderson::{Acceleration, MAX_DEPTH};
-use crate::method::{run_iterations, DeformationMethod, IterationObserver, Iterations, SolveSummary};
+use crate::method::{
+    require_phase, run_iterations, DeformationMethod, IterationObserver, Iterations, Phase, SolveSummary,
+};
 use crate::operators::{laplacian, LaplacianWeights};
 
 /// How the Laplacian coordinates of eq 1 are evaluated in the reduced iteration.
@@ -220,13 +222,7 @@ impl DeformationMethod for Isolines {
     }
 
     fn bind_handles(&mut self, handles: &HandleSet) -> Result<(), MethodError> {
-        let Some(rest) = &self.rest else {
-            return Err(MethodError::Phase {
-                method: self.name,
-                phase: "bind_handles",
-                missing: "precompute",
-            });
-        };
+        let rest = require_phase(self.rest.as_ref(), self.name, Phase::BindHandles)?;
         handles.check_mesh_size(self.current.len())?;
         if handles.regions().len() < 2 {
             return Err(MethodError::Handles(format!(
@@ -288,9 +284,7 @@ impl DeformationMethod for Isolines {
         observer: &mut dyn IterationObserver,
     ) -> Result<SolveSummary, MethodError> {
         let name = self.name;
-        let (Some(rest), Some(bound)) = (&self.rest, &mut self.bound) else {
-            return Err(MethodError::Phase { method: name, phase: "solve", missing: "bind_handles" });
-        };
+        let (rest, bound) = require_phase(self.rest.as_ref().zip(self.bound.as_mut()), name, Phase::Solve)?;
         targets.check_for(&bound.handles)?;
         let t0 = Instant::now();
         let constraint_rhs = bound.system.constraint_rhs(&bound.model, &bound.handles, targets);

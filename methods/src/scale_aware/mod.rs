@@ -84,8 +84,8 @@ use crate::handles::{HandleSet, HandleTargets};
 use crate::laplacian::{LaplacianEditing, LaplacianParams};
 use crate::laplacian_coordinates::DeltaFrame;
 use crate::method::{
-    max_displacement, move_to, run_iterations, DeformationMethod, IterationObserver, IterationReport,
-    Iterations, NoObserver, ReusedSolve, SolveSummary,
+    max_displacement, move_to, require_phase, run_iterations, DeformationMethod, IterationObserver,
+    IterationReport, Iterations, NoObserver, Phase, ReusedSolve, SolveSummary,
 };
 use crate::operators::LaplacianWeights;
 use crate::rotation_fit::Mat3;
@@ -461,13 +461,7 @@ impl DeformationMethod for ScaleAware {
     }
 
     fn bind_handles(&mut self, handles: &HandleSet) -> Result<(), MethodError> {
-        let Some(rest) = &self.rest else {
-            return Err(MethodError::Phase {
-                method: self.name,
-                phase: "bind_handles",
-                missing: "precompute",
-            });
-        };
+        let rest = require_phase(self.rest.as_ref(), self.name, Phase::BindHandles)?;
         handles.check_mesh_size(self.current.len())?;
         if handles.n_constrained() < 3 {
             return Err(MethodError::Handles(format!(
@@ -497,9 +491,7 @@ impl DeformationMethod for ScaleAware {
         targets: &HandleTargets,
         observer: &mut dyn IterationObserver,
     ) -> Result<SolveSummary, MethodError> {
-        let Some(bound) = &self.bound else {
-            return Err(MethodError::Phase { method: self.name, phase: "solve", missing: "bind_handles" });
-        };
+        let bound = require_phase(self.bound.as_ref(), self.name, Phase::Solve)?;
         targets.check_for(&bound.handles)?;
         let start = Instant::now();
         self.reused = None;

@@ -53,7 +53,9 @@ pub use local_frames::LocalFrameDetails;
 use crate::error::MethodError;
 use crate::handles::{HandleSet, HandleTargets};
 use crate::linalg::spectral::{smallest_eigenpairs, EigenOptions};
-use crate::method::{DeformationMethod, IterationObserver, IterationReport, SolveSummary};
+use crate::method::{
+    require_phase, DeformationMethod, IterationObserver, IterationReport, Phase, SolveSummary,
+};
 use crate::operators::{laplacian, lumped_mass_for, LaplacianWeights, MassKind};
 
 /// How the handle constraints enter the reduced system.
@@ -337,13 +339,7 @@ impl DeformationMethod for SpectralMhb {
     }
 
     fn bind_handles(&mut self, handles: &HandleSet) -> Result<(), MethodError> {
-        if self.details.is_none() {
-            return Err(MethodError::Phase {
-                method: "spectral_mhb",
-                phase: "bind_handles",
-                missing: "precompute",
-            });
-        }
+        require_phase(self.details.as_ref(), "spectral_mhb", Phase::BindHandles)?;
         handles.check_mesh_size(self.rest.len())?;
         let start = Instant::now();
         let constrained: Vec<u32> = handles.constrained().collect();
@@ -398,13 +394,7 @@ impl DeformationMethod for SpectralMhb {
         targets: &HandleTargets,
         observer: &mut dyn IterationObserver,
     ) -> Result<SolveSummary, MethodError> {
-        let Some(bound) = &self.bound else {
-            return Err(MethodError::Phase {
-                method: "spectral_mhb",
-                phase: "solve",
-                missing: "bind_handles",
-            });
-        };
+        let bound = require_phase(self.bound.as_ref(), "spectral_mhb", Phase::Solve)?;
         targets.check_for(&bound.handles)?;
         let start = Instant::now();
         let m = self.basis.ncols();
