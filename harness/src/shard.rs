@@ -41,32 +41,19 @@ impl fmt::Display for Shard {
     }
 }
 
-/// Seconds per 1000 vertices per edit step of each method: the median `total_s / (#V / 1000)` over the
-/// four survey tests of a `harness all` on this project's 2-core machine (at 11f8f45). Only the
-/// ratios matter: they make `arap` and `scale_aware` count for a hundred `isolines`.
-const SECONDS_PER_KILOVERTEX: [(&str, f64); 8] = [
-    (methods::registry::LAPLACIAN, 0.10),
-    (methods::registry::ARAP, 0.25),
-    (methods::registry::HIRM, 0.043),
-    (methods::registry::SPECTRAL_MHB, 0.039),
-    (methods::registry::SCALE_AWARE, 0.48),
-    (methods::registry::SCALE_AWARE_ORA, 0.44),
-    (methods::registry::ISOLINES, 0.0042),
-    (methods::registry::ISOLINES_T1, 0.0081),
-];
-
-/// Estimated cost of running `methods` on `scenario` (in seconds on the reference machine; a sweep
-/// point, `isolines[isolines=10]`, at its base method's rate; a method without a measured rate
-/// counts as the most expensive one).
+/// Estimated cost of running `methods` on `scenario`: seconds on the reference machine, each method
+/// at its registry entry's rate ([`methods::registry::MethodEntry::seconds_per_kilovertex`]; a
+/// sweep point, `isolines[isolines=10]`, at its base method's; a method the registry does not know,
+/// external or a variant under another name, at the most expensive rate).
 pub fn estimated_cost(scenario: &LoadedScenario, methods: &[&str]) -> f64 {
-    let slowest = SECONDS_PER_KILOVERTEX.iter().map(|(_, s)| *s).fold(0.0, f64::max);
+    let slowest = methods::registry::METHODS.iter().map(|m| m.seconds_per_kilovertex).fold(0.0, f64::max);
     let kilovertices = scenario.mesh.n_vertices() as f64 / 1000.0;
     let steps = scenario.steps.len() as f64;
     methods
         .iter()
         .map(|m| {
             let base = crate::sweep::base_method(m);
-            SECONDS_PER_KILOVERTEX.iter().find(|(name, _)| *name == base).map_or(slowest, |(_, s)| *s)
+            methods::registry::find(base).map_or(slowest, |m| m.seconds_per_kilovertex)
         })
         .sum::<f64>()
         * kilovertices

@@ -32,6 +32,24 @@ pub struct MethodEntry {
     pub create: fn(&toml::Table) -> Result<Box<dyn DeformationMethod>, MethodError>,
     /// Whether `solve` iterates (takes `max_iterations` and `tolerance`); `false` for a direct solve.
     pub iterative: bool,
+    /// Its cost, seconds per 1000 vertices per edit step: what the harness balances a cluster's
+    /// shards by (only the ratios between methods matter). Measured as the median
+    /// `total_s / (#V / 1000)` over the four survey tests of a `harness all` on the project's 2-core
+    /// machine (at 11f8f45).
+    pub seconds_per_kilovertex: f64,
+    /// Its side of HIRM's Table 1 (Wu et al. 2015), if it is one of the two compared there.
+    pub table1: Option<Table1Side>,
+}
+
+/// The two sides of HIRM's Table 1 (Wu et al. 2015): the time to take a new handle set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Table1Side {
+    /// The handle-independent model: the update is its phase `t_h`
+    /// ([`crate::keys::phase::T_H_HANDLE_UPDATE`]); it also reports `t_e`, `t_b`, `n_field` and
+    /// `n_t`.
+    HandleIndependent,
+    /// The handle-aware model, rebuilt for each handle set: the update is its whole `bind_handles`.
+    Rebuilt,
 }
 
 /// Every method of the suite, in report order.
@@ -41,50 +59,71 @@ pub const METHODS: &[MethodEntry] = &[
         summary: "unreduced iterative Laplacian editing (Au et al. 2007 sec. 3, eq 1-3), the reference the reduced models approximate",
         create: |p| Ok(Box::new(LaplacianEditing::new(parse(LAPLACIAN, p)?)?)),
         iterative: true,
+        seconds_per_kilovertex: 0.10,
+        table1: None,
     },
     MethodEntry {
         name: ARAP,
         summary: "As-Rigid-As-Possible surface modeling (Sorkine & Alexa 2007), cotangent weights (intrinsic Delaunay by default), hard constraints",
         create: |p| Ok(Box::new(Arap::new(parse(ARAP, p)?)?)),
         iterative: true,
+        seconds_per_kilovertex: 0.25,
+        table1: None,
     },
     MethodEntry {
         name: HIRM,
         summary: "handle-independent reduced model for incremental editing: isolines of Laplacian eigenvectors, background precompute (Wu, Au, Tai & Lu 2015)",
         create: |p| Ok(Box::new(Hirm::new(parse(HIRM, p)?)?)),
         iterative: true,
+        seconds_per_kilovertex: 0.043,
+        table1: Some(Table1Side::HandleIndependent),
     },
     MethodEntry {
         name: SPECTRAL_MHB,
         summary: "spectral mesh deformation in manifold harmonics bases with deformation transfer of details (Rong, Cao & Guo 2008)",
         create: |p| Ok(Box::new(SpectralMhb::new(parse(SPECTRAL_MHB, p)?)?)),
         iterative: false,
+        seconds_per_kilovertex: 0.039,
+        table1: None,
     },
     MethodEntry {
         name: SCALE_AWARE,
         summary: "scale-aware shape manipulation: triangle and edge angles, normals on the Gauss map, then G(Theta, N) V = 0 (Liu, Wang, Liu & Liu 2014)",
         create: |p| Ok(Box::new(ScaleAware::new(SCALE_AWARE, parse(SCALE_AWARE, p)?)?)),
         iterative: true,
+        seconds_per_kilovertex: 0.48,
+        table1: None,
     },
     MethodEntry {
         name: SCALE_AWARE_ORA,
         summary: "`scale_aware` followed by the optimal rigidity approximation: triangles rescaled to their rest areas and stitched (section 5.3)",
         create: |p| Ok(Box::new(ScaleAware::new(SCALE_AWARE_ORA, parse(SCALE_AWARE_ORA, p)?)?)),
         iterative: true,
+        seconds_per_kilovertex: 0.44,
+        table1: None,
     },
     MethodEntry {
         name: ISOLINES,
         summary: "handle-aware isolines reduced model (Au, Fu, Tai & Cohen-Or 2007), n_iso = 20, isoline-interpolated Laplacian coordinates (Table 1 t_2)",
         create: |p| Ok(Box::new(Isolines::new(ISOLINES, parse(ISOLINES, p)?)?)),
         iterative: true,
+        seconds_per_kilovertex: 0.0042,
+        table1: Some(Table1Side::Rebuilt),
     },
     MethodEntry {
         name: ISOLINES_T1,
         summary: "`isolines` with vertex interpolation only: Laplacian coordinates on the whole mesh per iteration (Au et al. 2007 eq 6, Table 1 t_1)",
         create: |p| Ok(Box::new(Isolines::new(ISOLINES_T1, parse(ISOLINES_T1, p)?)?)),
         iterative: true,
+        seconds_per_kilovertex: 0.0081,
+        table1: None,
     },
 ];
+
+/// The registered method on `side` of HIRM's Table 1.
+pub fn table1_method(side: Table1Side) -> Option<&'static MethodEntry> {
+    METHODS.iter().find(|m| m.table1 == Some(side))
+}
 
 /// Names of all registered methods.
 pub fn method_names() -> Vec<&'static str> {
@@ -108,4 +147,22 @@ fn parse<P: DeserializeOwned>(method: &'static str, table: &toml::Table) -> Resu
     toml::Value::Table(table.clone())
         .try_into()
         .map_err(|e: toml::de::Error| MethodError::Parameters { method, message: e.message().to_string() })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_entry_describes_itself_for_the_harness() {
+        for m in METHODS {
+            assert!(m.seconds_per_kilovertex.is_finite() && m.seconds_per_kilovertex > 0.0, "{}", m.name);
+        }
+        for side in [Table1Side::HandleIndependent, Table1Side::Rebuilt] {
+            let sides = METHODS.iter().filter(|m| m.table1 == Some(side)).count();
+            assert_eq!(sides, 1, "one method on each side of Table 1, {side:?} has {sides}");
+        }
+        assert_eq!(table1_method(Table1Side::HandleIndependent).map(|m| m.name), Some(HIRM));
+        assert_eq!(table1_method(Table1Side::Rebuilt).map(|m| m.name), Some(ISOLINES));
+    }
 }

@@ -105,7 +105,7 @@ pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, H
         .iter()
         .filter(|r| {
             r.scenario.ends_with("-handles")
-                && (r.method == methods::registry::HIRM || r.method == methods::registry::ISOLINES)
+                && methods::registry::find(&r.method).is_ok_and(|m| m.table1.is_some())
         })
         .collect();
     if !handle_scenarios.is_empty() {
@@ -821,7 +821,8 @@ fn draw_table1<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult]) ->
         c.steps
             .iter()
             .filter_map(|s| {
-                let seconds = if c.method == methods::registry::HIRM {
+                let side = methods::registry::find(&c.method).ok().and_then(|m| m.table1);
+                let seconds = if side == Some(methods::registry::Table1Side::HandleIndependent) {
                     s.phase_timings
                         .iter()
                         .find(|(k, _)| k == methods::keys::phase::T_H_HANDLE_UPDATE)

@@ -11,6 +11,7 @@ use crate::provenance::Provenance;
 use crate::record::CaseResult;
 use crate::scenario::{LoadedScenario, SkippedInput};
 use crate::shard::Shard;
+use methods::registry::Table1Side;
 
 /// The CSV columns before the metrics, with units in the names.
 const CASE_COLUMNS: &[&str] = &[
@@ -169,22 +170,26 @@ pub fn render_handle_updates(results: &[CaseResult]) -> Result<Vec<u8>, HarnessE
     w.into_inner().map_err(|e| HarnessError::Report(format!("CSV: {e}")))
 }
 
-/// `table1.md`: HIRM's Table 1 for every scenario that runs `hirm` and `isolines`: per step the
-/// number of handles, `hirm`'s handle update `t_h` against the `isolines` rebuild (its whole
+/// `table1.md`: HIRM's Table 1 for every scenario that runs both of its sides
+/// ([`methods::registry::Table1Side`]; `hirm` and `isolines`): per step the number of handles, the
+/// handle-independent model's update `t_h` against the rebuild of the other (its whole
 /// `bind_handles`), their ratio `P`, and both per-iteration times.
 pub fn render_table1(results: &[CaseResult]) -> String {
-    let mut out = String::from(
-        "# Handle-set update: `hirm` against the `isolines` rebuild (Wu et al. 2015, Table 1)\n\n\
-         t_h: hirm's handle update (eq 26 and the factorization); rebuild: the whole bind of isolines \
+    let name = |side| methods::registry::table1_method(side).map_or("-", |m| m.name);
+    let (hirm, isolines) = (name(Table1Side::HandleIndependent), name(Table1Side::Rebuilt));
+    let mut out = format!(
+        "# Handle-set update: `{hirm}` against the `{isolines}` rebuild (Wu et al. 2015, Table 1)\n\n\
+         t_h: {hirm}'s handle update (eq 26 and the factorization); rebuild: the whole bind of {isolines} \
          (harmonic fields, isolines, reduced system). P = t_h / rebuild. t_i: median iteration.\n\n\
-         | scenario | step | n_h | n_field | n_t | t_e (s) | t_b (s) | t_h (ms) | rebuild (ms) | P (%) | t_i hirm (ms) | t_i isolines (ms) |\n\
+         | scenario | step | n_h | n_field | n_t | t_e (s) | t_b (s) | t_h (ms) | rebuild (ms) | P (%) | t_i {hirm} (ms) | t_i {isolines} (ms) |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let stat =
         |r: &CaseResult, name: &str| phase(&r.statistics, name).map_or("-".to_string(), |v| format!("{v}"));
-    for hirm in results.iter().filter(|r| r.method == methods::registry::HIRM) {
+    let side = |r: &CaseResult| methods::registry::find(&r.method).ok().and_then(|m| m.table1);
+    for hirm in results.iter().filter(|r| side(r) == Some(Table1Side::HandleIndependent)) {
         let Some(isolines) =
-            results.iter().find(|r| r.method == methods::registry::ISOLINES && r.scenario == hirm.scenario)
+            results.iter().find(|r| side(r) == Some(Table1Side::Rebuilt) && r.scenario == hirm.scenario)
         else {
             continue;
         };
