@@ -207,19 +207,19 @@ pub fn publish(
     let table1 = report::render_table1(&run.results);
     html::write_index(
         dir,
-        &html::render_index(
-            &run.results,
-            &run.data_source,
-            &run.provenance.summary(),
-            &images,
-            &table1,
-            &peers,
-            &outcome,
-            &run.notes,
-            &viewable,
-            &dataset,
-            &size_series,
-        ),
+        &html::render_index(&html::PageContext {
+            results: &run.results,
+            data_source: &run.data_source,
+            provenance: &run.provenance.summary(),
+            images: &images,
+            table1_markdown: &table1,
+            peers: &peers,
+            gate: &outcome,
+            notes: &run.notes,
+            viewable: &viewable,
+            dataset: &dataset,
+            size_series: &size_series,
+        }),
     )?;
     timed(RunPhase::GateAndIndex, start);
 

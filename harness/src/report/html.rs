@@ -28,24 +28,112 @@ fn number(v: f64, digits: usize) -> String {
     }
 }
 
-/// The page for `results` (with `data_source` and the run's `provenance` line), linking `images` (paths relative to the report
-/// directory: plots and figures) and showing `table1_markdown` (HIRM's Table 1 as written to
-/// `table1.md`) and `peers` (our ARAP against libigl's, `peers.md`; empty: none); the cases whose
-/// stems `viewable` names open in the 3D view.
-pub fn render_index(
-    results: &[CaseResult],
-    data_source: &str,
-    provenance: &str,
-    images: &[PathBuf],
-    table1_markdown: &str,
-    peers: &str,
-    gate: &GateOutcome,
-    notes: &[String],
-    viewable: &[String],
-    dataset: &str,
-    size_series: &str,
-) -> String {
+/// What every section of the page reads: the run's records and what the run wrote beside them.
+pub struct PageContext<'a> {
+    pub results: &'a [CaseResult],
+    /// Where the meshes came from, in words.
+    pub data_source: &'a str,
+    /// The run's provenance line.
+    pub provenance: &'a str,
+    /// Plots and figures, relative to the report directory.
+    pub images: &'a [PathBuf],
+    /// HIRM's Table 1 as written to `table1.md`.
+    pub table1_markdown: &'a str,
+    /// Our ARAP against libigl's (`peers.md`; empty: none).
+    pub peers: &'a str,
+    pub gate: &'a GateOutcome,
+    /// Notes on the inputs.
+    pub notes: &'a [String],
+    /// The case file stems that open in the 3D view.
+    pub viewable: &'a [String],
+    /// `dataset.md` (empty: not a dataset run).
+    pub dataset: &'a str,
+    /// `size-series.md` (empty: no series).
+    pub size_series: &'a str,
+}
+
+/// A section of the page: appends its HTML (nothing when it has nothing to show).
+type Section = fn(&mut String, &PageContext);
+
+/// The page, top to bottom: adding a section is one function and one line here.
+const SECTIONS: &[Section] = &[
+    head,
+    regression_gate,
+    across_the_dataset,
+    answer_first,
+    cost_against_size,
+    results_table,
+    view_3d,
+    glossary,
+    input_notes,
+    arap_against_libigl,
+    quality_against_time,
+    rendered_results,
+    plots,
+    table1,
+    every_render,
+    scripts,
+];
+
+/// The page of a run, its sections ([`SECTIONS`]) over one `context`.
+pub fn render_index(context: &PageContext) -> String {
     let mut page = String::new();
+    for section in SECTIONS {
+        section(&mut page, context);
+    }
+    page
+}
+
+/// The groups the page shows its images in, by file name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum ImageGroup {
+    /// `dataset-*`, `worst-*`: across the dataset.
+    Dataset,
+    /// `size-series*`: cost against size.
+    SizeSeries,
+    /// `figures/grid*`: the rendered result grids.
+    Grid,
+    /// Every other render under `figures/`.
+    Render,
+    /// `*-pareto`: quality against time.
+    Pareto,
+    /// The other plots.
+    Plot,
+}
+
+impl ImageGroup {
+    fn of(path: &Path) -> ImageGroup {
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        if name.starts_with("dataset-") || name.starts_with("worst-") {
+            ImageGroup::Dataset
+        } else if name.starts_with("size-series") {
+            ImageGroup::SizeSeries
+        } else if path.starts_with("figures") {
+            if name.starts_with("grid") {
+                ImageGroup::Grid
+            } else {
+                ImageGroup::Render
+            }
+        } else if caption_for(path).ends_with("-pareto") {
+            ImageGroup::Pareto
+        } else {
+            ImageGroup::Plot
+        }
+    }
+}
+
+impl PageContext<'_> {
+    /// The PNG images of `group`, in the run's order.
+    fn images(&self, group: ImageGroup) -> Vec<&PathBuf> {
+        self.images
+            .iter()
+            .filter(|p| p.extension().is_some_and(|e| e == "png") && ImageGroup::of(p) == group)
+            .collect()
+    }
+}
+
+/// The document head, the title, the data source and the provenance.
+fn head(page: &mut String, context: &PageContext) {
     page.push_str(concat!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n",
         "<title>deformbench report</title>\n<style>\n",
@@ -87,9 +175,14 @@ pub fn render_index(
     let _ = writeln!(
         page,
         "<p>Data: {}. Times in seconds, iteration times in milliseconds.</p>",
-        escape(data_source)
+        escape(context.data_source)
     );
-    let _ = writeln!(page, "<p id=\"provenance\">Made by this {}.</p>", escape(provenance));
+    let _ = writeln!(page, "<p id=\"provenance\">Made by this {}.</p>", escape(context.provenance));
+}
+
+/// The quality-regression gate's verdict.
+fn regression_gate(page: &mut String, context: &PageContext) {
+    let gate = context.gate;
     page.push_str("<h2 id=\"verdict\">Quality regression gate</h2>\n");
     match gate {
         GateOutcome::Checked { baseline, findings } => {
@@ -115,41 +208,44 @@ pub fn render_index(
             let _ = writeln!(page, "<p>Not checked: {}</p>", escape(reason));
         }
     }
-    let is_dataset = |p: &&PathBuf| {
-        p.file_name().is_some_and(|n| {
-            let n = n.to_string_lossy();
-            n.starts_with("dataset-") || n.starts_with("worst-")
-        })
-    };
-    let (dataset_images, images): (Vec<&PathBuf>, Vec<&PathBuf>) =
-        images.iter().filter(|p| p.extension().is_some_and(|e| e == "png")).partition(is_dataset);
-    let is_series =
-        |p: &&PathBuf| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("size-series"));
-    let (series_images, images): (Vec<&PathBuf>, Vec<&PathBuf>) = images.into_iter().partition(is_series);
-    if !dataset.is_empty() {
-        page.push_str(
-            "<h2 id=\"dataset\">Across the dataset</h2>\n<p>The same tables as <code>dataset.md</code>: how often \
-             each method broke per edit family, how its error spreads, what it costs and how that grows with the mesh; \
-             then the error distributions, the cost curves and each family's worst <code>ok</code> results beside arap's. \
-             The results table below filters by family, mesh, surface, genus and size.</p>\n",
-        );
-        // The per-family headings of dataset.md, which markdown_table leaves out, as paragraphs.
-        page.push_str(&markdown_table(&dataset.replace("\n### ", "\nEdit family: ")));
-        for p in dataset_images {
-            image(&mut page, p, caption_for(p));
-        }
-    }
-    answer_first(&mut page);
-    if !size_series.is_empty() {
-        page.push_str(
-            "<h2 id=\"size-series\">Cost against size</h2>\n<p>(Also in <code>size-series.md</code>.)</p>\n",
-        );
-        page.push_str(&markdown_table(&size_series.replace("\n## ", "\nSeries: ")));
-        for p in series_images {
-            image(&mut page, p, caption_for(p));
-        }
-    }
+}
 
+/// Across the dataset: `dataset.md`'s tables, the error distributions, the cost curves and each
+/// family's worst results.
+fn across_the_dataset(page: &mut String, context: &PageContext) {
+    if context.dataset.is_empty() {
+        return;
+    }
+    page.push_str(
+        "<h2 id=\"dataset\">Across the dataset</h2>\n<p>The same tables as <code>dataset.md</code>: how often \
+         each method broke per edit family, how its error spreads, what it costs and how that grows with the mesh; \
+         then the error distributions, the cost curves and each family's worst <code>ok</code> results beside arap's. \
+         The results table below filters by family, mesh, surface, genus and size.</p>\n",
+    );
+    // The per-family headings of dataset.md, which markdown_table leaves out, as paragraphs.
+    page.push_str(&markdown_table(&context.dataset.replace("\n### ", "\nEdit family: ")));
+    for p in context.images(ImageGroup::Dataset) {
+        image(page, p, caption_for(p));
+    }
+}
+
+/// Cost against size: `size-series.md` and its plots.
+fn cost_against_size(page: &mut String, context: &PageContext) {
+    if context.size_series.is_empty() {
+        return;
+    }
+    page.push_str(
+        "<h2 id=\"size-series\">Cost against size</h2>\n<p>(Also in <code>size-series.md</code>.)</p>\n",
+    );
+    page.push_str(&markdown_table(&context.size_series.replace("\n## ", "\nSeries: ")));
+    for p in context.images(ImageGroup::SizeSeries) {
+        image(page, p, caption_for(p));
+    }
+}
+
+/// The results table: a row per case, every timing and measure, sortable and filtered by the page
+/// script; a row with a result mesh opens the 3D view.
+fn results_table(page: &mut String, context: &PageContext) {
     page.push_str(
         "<h2 id=\"results\">Results</h2>\n<div id=\"filters\"></div>\n<div class=\"scroll\"><table id=\"results-table\">\n<thead><tr>\
          <th data-key=\"scenario\">scenario</th><th data-key=\"method\">method</th>\
@@ -173,7 +269,7 @@ pub fn render_index(
     page.push_str(
         "<th data-key=\"self_intersecting\">self-intersecting (open3d)</th></tr></thead>\n<tbody>\n",
     );
-    for r in results {
+    for r in context.results {
         let (class, badge) = match r.origin {
             Origin::BuiltIn => (
                 r.status.kind().to_string(),
@@ -210,7 +306,7 @@ pub fn render_index(
             member_attributes(r),
             {
                 let stem = crate::stored_report::case_file_stem(&r.scenario, &r.method);
-                if viewable.contains(&stem) {
+                if context.viewable.contains(&stem) {
                     format!(
                         " data-view=\"{}\" data-rest=\"{}.rest\"",
                         escape(&stem),
@@ -259,6 +355,10 @@ pub fn render_index(
         );
     }
     page.push_str("</tbody></table></div>\n");
+}
+
+/// The 3D view (filled by `viewer.js` when a row is clicked).
+fn view_3d(page: &mut String, _: &PageContext) {
     page.push_str(concat!(
         "<div id=\"viewer\" hidden><p><b id=\"viewer-title\"></b> &mdash; drag to turn, wheel to zoom ",
         "<button id=\"viewer-reset\">reset</button> colour <select id=\"viewer-colour\">",
@@ -273,6 +373,10 @@ pub fn render_index(
         "<span class=\"viewer-name\" id=\"viewer-right-name\"></span>",
         "<span class=\"viewer-pick\" id=\"viewer-right-pick\" hidden></span></span></div>\n"
     ));
+}
+
+/// What the columns mean: every measure of the metric table, and the statuses.
+fn glossary(page: &mut String, _: &PageContext) {
     page.push_str("<h2 id=\"measures\">What the columns mean</h2>\n<p>Every measure compares the result with the rest mesh:</p>\n");
     page.push_str("<dl class=\"metrics\">\n");
     for spec in &METRICS {
@@ -295,7 +399,11 @@ pub fn render_index(
          peer libraries' methods (<code>--peers</code>, <code>configs/peers.toml</code>), <span class=\"origin\">external</span> \
          other programs over the method protocol (README); hover the mark for what ran.</p>\n",
     );
+}
 
+/// Notes on the inputs (skipped meshes, repairs).
+fn input_notes(page: &mut String, context: &PageContext) {
+    let notes = context.notes;
     if !notes.is_empty() {
         page.push_str("<h2 id=\"notes\">Notes on the inputs</h2>\n<ul>\n");
         for n in notes {
@@ -303,40 +411,51 @@ pub fn render_index(
         }
         page.push_str("</ul>\n");
     }
+}
+
+/// Our arap against libigl's (`peers.md`).
+fn arap_against_libigl(page: &mut String, context: &PageContext) {
+    let peers = context.peers;
     if !peers.is_empty() {
         page.push_str("<h2 id=\"arap-libigl\">Our arap against libigl's</h2>\n");
-        page.push_str(&markdown_table(&peers));
+        page.push_str(&markdown_table(peers));
     }
+}
 
-    let (figures, plots): (Vec<&PathBuf>, Vec<&PathBuf>) =
-        images.into_iter().partition(|p| p.starts_with("figures"));
-    let (pareto, plots): (Vec<&PathBuf>, Vec<&PathBuf>) =
-        plots.into_iter().partition(|p| caption_for(p).ends_with("-pareto"));
-    quality_against_time(&mut page, results, &pareto);
-    let grids: Vec<&&PathBuf> = figures
-        .iter()
-        .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("grid")))
-        .collect();
+/// The rendered result grids.
+fn rendered_results(page: &mut String, context: &PageContext) {
+    let grids = context.images(ImageGroup::Grid);
     if !grids.is_empty() {
         page.push_str("<h2 id=\"figures\">Rendered results</h2>\n");
         for g in grids {
-            image(&mut page, g, caption_for(g));
+            image(page, g, caption_for(g));
         }
     }
+}
+
+/// Every other plot.
+fn plots(page: &mut String, context: &PageContext) {
+    let plots = context.images(ImageGroup::Plot);
     if !plots.is_empty() {
         page.push_str("<h2 id=\"plots\">Plots</h2>\n");
         for p in &plots {
-            image(&mut page, p, caption_for(p));
+            image(page, p, caption_for(p));
         }
     }
+}
+
+/// HIRM's Table 1, when a scenario ran both of its sides.
+fn table1(page: &mut String, context: &PageContext) {
+    let table1_markdown = context.table1_markdown;
     if table1_markdown.lines().filter(|l| l.starts_with('|')).count() > 2 {
         page.push_str("<h2 id=\"table1\">Handle-set update (HIRM Table 1)</h2>\n");
         page.push_str(&markdown_table(table1_markdown));
     }
-    let single: Vec<&&PathBuf> = figures
-        .iter()
-        .filter(|p| !p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("grid")))
-        .collect();
+}
+
+/// Every single render (rest shapes, results, heat maps), folded.
+fn every_render(page: &mut String, context: &PageContext) {
+    let single = context.images(ImageGroup::Render);
     if !single.is_empty() {
         let _ = writeln!(
             page,
@@ -353,6 +472,10 @@ pub fn render_index(
         }
         page.push_str("</details>\n");
     }
+}
+
+/// The page's scripts, inlined, and the image check the browser test reads.
+fn scripts(page: &mut String, _: &PageContext) {
     page.push_str("<script>\n");
     page.push_str(include_str!("page.js"));
     page.push_str(include_str!("viewer.js"));
@@ -372,12 +495,12 @@ pub fn render_index(
         "});\n",
         "</script>\n</body>\n</html>\n"
     ));
-    page
 }
 
 /// "Quality against time": per test with sweep points its plot, budget table, fronts and points.
-fn quality_against_time(page: &mut String, results: &[CaseResult], plots: &[&PathBuf]) {
+fn quality_against_time(page: &mut String, context: &PageContext) {
     use crate::report::quality_time;
+    let (results, plots) = (context.results, context.images(ImageGroup::Pareto));
     let scenarios = quality_time::swept_scenarios(results);
     if scenarios.is_empty() {
         return;
@@ -450,7 +573,7 @@ fn better_word(better: crate::metrics::Better) -> &'static str {
 /// "Which method": per test the methods ranked by a measure the reader picks, with their verdicts
 /// and time per edit, and each method's median rank across the tests; the page script fills it
 /// from the results table (`page.js`).
-fn answer_first(page: &mut String) {
+fn answer_first(page: &mut String, _: &PageContext) {
     page.push_str(
         "<h2 id=\"answer\">Which method</h2>\n<p>Rank by <select id=\"rank-by\"></select>: per test, the \
          finished cases from best to worst (colour: the verdict; suspect ones count, marked), with the time \
