@@ -15,6 +15,7 @@ use crate::regression::{self, GateOutcome};
 use crate::report::{MeshFormat, MeshOutput};
 use crate::scenario::load_specs;
 use crate::shard::Shard;
+use crate::staged_dir::StagedDir;
 use crate::suite::{self, SuiteOptions};
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
@@ -337,8 +338,9 @@ where
             options.python = peers.python_path();
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
+            let (staging, staged_options) = staged(&options)?;
             if let Some(shard) = shard {
-                return run_shard(&options, shard);
+                return run_shard(&staged_options, staging, shard);
             }
             let gate = if no_check {
                 GateRequest::Skip("--no-check".to_string())
@@ -346,17 +348,18 @@ where
                 GateRequest::for_suite(&options, gate.baseline)
             };
             let publish = PublishOptions { peer_python: peers.python()?, meshes: meshes.output() };
-            let mut run = suite::run(&options).context("preparing the run")?;
+            let mut run = suite::run(&staged_options).context("preparing the run")?;
             run.notes.extend(skipped_peers);
-            publish_and_print(&options, run, &publish, gate)
+            publish_and_print(&staged_options, staging, run, &publish, gate)
         }
         Command::Merge { partials, common, meshes, gate, sweeps } => {
             let mut options = common.options(Vec::new(), Vec::new(), &command_line);
             options.sweeps = sweeps.then(|| options.configs_dir.join("sweeps.toml"));
-            let run = suite::merge(&options, &partials).context("merging partial reports")?;
+            let (staging, staged_options) = staged(&options)?;
+            let run = suite::merge(&staged_options, &partials).context("merging partial reports")?;
             let gate = GateRequest::for_suite(&options, gate.baseline);
             let publish = PublishOptions { peer_python: None, meshes: meshes.output() };
-            publish_and_print(&options, run, &publish, gate)
+            publish_and_print(&staged_options, staging, run, &publish, gate)
         }
         Command::Run { methods, scenario, common, peers, meshes } => {
             let mut options = common.options(vec![scenario], methods, &command_line);
@@ -364,10 +367,12 @@ where
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
             let publish = PublishOptions { peer_python: peers.python()?, meshes: meshes.output() };
-            let mut run = suite::run(&options).context("preparing the run")?;
+            let (staging, staged_options) = staged(&options)?;
+            let mut run = suite::run(&staged_options).context("preparing the run")?;
             run.notes.extend(skipped_peers);
             publish_and_print(
-                &options,
+                &staged_options,
+                staging,
                 run,
                 &publish,
                 GateRequest::Skip("`run` covers one scenario".to_string()),
@@ -481,19 +486,31 @@ fn print_findings(findings: &[regression::Finding], baseline: &std::path::Path) 
     }
 }
 
-/// Run part `shard` of the suite and write its partial report.
-fn run_shard(options: &SuiteOptions, shard: Shard) -> anyhow::Result<ExitCode> {
+/// `options` with its report directory replaced by a staging directory beside it ([`StagedDir`]):
+/// the run writes its logs and reports there, and [`StagedDir::publish`] swaps the whole directory
+/// in at the end, so a run killed or failed at any moment leaves the old report or the new one.
+fn staged(options: &SuiteOptions) -> anyhow::Result<(StagedDir, SuiteOptions)> {
+    let staging = StagedDir::begin(&options.reports_dir)?;
+    let mut staged = options.clone();
+    staged.reports_dir = staging.path().to_path_buf();
+    Ok((staging, staged))
+}
+
+/// Run part `shard` of the suite and write its partial report (`options` writing into `staging`).
+fn run_shard(options: &SuiteOptions, staging: StagedDir, shard: Shard) -> anyhow::Result<ExitCode> {
     let run = suite::run_shard(options, shard).context("preparing the run")?;
     for note in &run.notes {
         eprintln!("note: {note}");
     }
     let failed = pipeline::publish_partial(options, &run, shard).context("writing the partial report")?;
+    let target = staging.target().to_path_buf();
+    staging.publish().context("publishing the partial report")?;
     print_table(&run.results);
     println!(
         "shard {shard}: {} scenario(s), {} case(s); partial report in {} (combine the N parts with `harness merge`)",
         run.scenarios.len(),
         run.results.len(),
-        options.reports_dir.display()
+        target.display()
     );
     if failed > 0 {
         eprintln!("error: {failed} case(s) failed: {} (see the status column)", failed_cases(&run.results));
@@ -502,10 +519,12 @@ fn run_shard(options: &SuiteOptions, shard: Shard) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Publish `run` ([`pipeline::publish`]), print its notes, table, phase times and gate findings,
-/// and pick the exit code: [`EXIT_CASE_FAILED`] over [`EXIT_REGRESSION`] over success.
+/// Publish `run` ([`pipeline::publish`] into `staging`, which `options` write into, then swapped
+/// in), print its notes, table, phase times and gate findings, and pick the exit code:
+/// [`EXIT_CASE_FAILED`] over [`EXIT_REGRESSION`] over success.
 fn publish_and_print(
     options: &SuiteOptions,
+    staging: StagedDir,
     mut run: suite::SuiteRun,
     publish: &PublishOptions,
     gate: GateRequest,
@@ -517,6 +536,8 @@ fn publish_and_print(
     let pool = crate::threads::pool(options.threads)?;
     let outcome =
         pool.install(|| pipeline::publish(options, &mut run, publish, gate)).context("publishing the run")?;
+    let target = staging.target().to_path_buf();
+    staging.publish().context("publishing the report directory")?;
     println!("data: {}", run.data_source);
     println!("{}", run.provenance.summary());
     print_table(&run.results);
@@ -524,7 +545,7 @@ fn publish_and_print(
         println!("\n{}", outcome.arap_against_libigl);
     }
     print_phases(&outcome);
-    println!("reports: {} (open index.html)", options.reports_dir.display());
+    println!("reports: {} (open index.html)", target.display());
     let gate_code = match &outcome.gate {
         GateOutcome::Checked { baseline, findings } => print_findings(findings, baseline),
         GateOutcome::NotChecked(reason) => {

@@ -15,7 +15,8 @@
 //! stored_report, regression, pareto   records on disk (results.json), the gate, the fronts
 //! record, provenance             the run's record: what each case measured; where and how it ran
 //! config, scenario, shard, sweep, metrics, verdict   what a run is made of, measures, verdict rules
-//! paths, error, threads, variables, memory           the workspace, errors, threads, ${VAR}, RSS
+//! paths, error, threads, variables, memory, staged_dir   the workspace, errors, threads, ${VAR},
+//!                                RSS, a directory replaced whole
 //! ```
 
 pub mod case;
@@ -36,6 +37,7 @@ pub mod report;
 pub mod scenario;
 pub mod self_intersection;
 pub mod shard;
+pub mod staged_dir;
 pub mod stored_report;
 pub mod suite;
 pub mod sweep;
