@@ -156,7 +156,7 @@ pub struct MetricSpec {
     pub label: &'static str,
     /// Unit for people (empty: dimensionless).
     pub unit: &'static str,
-    /// What it measures, with its formula (shown on index.html; the README has the same).
+    /// What it measures, with its formula (shown on index.html; docs/design.md has the same table).
     pub doc: &'static str,
     pub better: Better,
     /// `None`: reported, not gated.
