@@ -437,12 +437,26 @@ mod tests {
         let script = "setsid sh -c 'sleep 300' & sleep 300";
         let mut p = MethodProcess::start("sh", &["-c".into(), script.into()], None, &[], None).unwrap();
         let token = p.token.clone();
+        // The session (field 6 of /proc/<pid>/stat) of a process.
+        let session = |pid: u32| -> Option<String> {
+            let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+            stat.rsplit(')').next()?.split_whitespace().nth(3).map(str::to_string)
+        };
+        // Wait until the sleeper has left the session, not only until it was forked: killed while
+        // still in the program's group, it would go with the group and never be an escapee.
+        let escaped = || {
+            let ours = session(p.child.id());
+            carriers(&token).into_iter().any(|pid| session(pid).is_some_and(|s| Some(s) != ours))
+        };
         let deadline = Instant::now() + Duration::from_secs(10);
-        while carriers(&token).len() < 3 && Instant::now() < deadline {
+        while !(carriers(&token).len() >= 3 && escaped()) && Instant::now() < deadline {
             std::thread::sleep(Duration::from_millis(20));
         }
         let before = carriers(&token);
-        assert!(before.len() >= 3, "sh, its sleep and the setsid one: {before:?}");
+        assert!(
+            before.len() >= 3 && escaped(),
+            "sh, its sleep and the setsid one, out of the session: {before:?}"
+        );
         p.kill();
         let after: Vec<u32> = carriers(&token).into_iter().filter(|&pid| running(pid)).collect();
         assert!(after.is_empty(), "still running: {after:?}");
