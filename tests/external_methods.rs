@@ -130,7 +130,10 @@ fn processes_with(needle: &str) -> Vec<u32> {
 #[test]
 fn a_broken_method_beside_built_in_ones_fails_alone_and_leaves_nothing_running() {
     let dir = tempfile::tempdir().unwrap();
-    let toy = support::workspace_root().join("tests/external/toy_method.py");
+    // A copy of its own: the processes it looks for afterwards are this test's, not the toys other
+    // tests of this file run at the same time.
+    let toy = dir.path().join("toy_method.py");
+    std::fs::copy(support::workspace_root().join("tests/external/toy_method.py"), &toy).unwrap();
     let pid_file = dir.path().join("grandchild.pid");
     let toys = format!(
         "[toy_crash]\ncommand = [\"python3\", \"{toy}\", \"crash-in-solve\"]\n\n\
