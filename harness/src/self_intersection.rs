@@ -1,6 +1,7 @@
 //! The self-intersection check of the results: open3d's `TriangleMesh.is_self_intersecting` on every
-//! result, through `python/self_intersection.py` (the project's venv, see `scripts/python-env`). Opt-in (`--self-intersections`): open3d's test is quadratic-ish in the
-//! face count, about 25 s per result on the 80K-face bumpy plane.
+//! result, through `python/self_intersection.py` (the project's venv, see `scripts/python-env`).
+//! Opt-in (`--self-intersections`): open3d's test is quadratic-ish in the face count, about 25 s per
+//! result on the 80K-face bumpy plane.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

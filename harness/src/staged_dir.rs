@@ -200,7 +200,9 @@ fn swap(a: &Path, b: &Path) -> std::io::Result<()> {
 
 /// `b` aside, `a` to `b`, the old `b` to `a`: a swap with a moment where `b` is missing.
 fn swap_by_renames(a: &Path, b: &Path) -> std::io::Result<()> {
-    let aside = a.with_extension("old");
+    let mut aside = a.as_os_str().to_owned();
+    aside.push(".old");
+    let aside = PathBuf::from(aside);
     std::fs::rename(b, &aside)?;
     std::fs::rename(a, b)?;
     std::fs::rename(&aside, a)

@@ -153,12 +153,6 @@ pub fn prepare(options: &SuiteOptions) -> Result<Prepared, HarnessError> {
             HarnessError::Config { path: catalog.path().to_path_buf(), message: format!("{message}{hint}") }
         })?;
     }
-    if options.reports_dir.exists() && !options.reports_dir.is_dir() {
-        return Err(HarnessError::Config {
-            path: options.reports_dir.clone(),
-            message: "--reports names a file; it must be a directory (or not exist yet)".into(),
-        });
-    }
     if let Some(sweeps) = &options.sweeps {
         check_sweep_scenarios(options, &catalog, sweeps)?;
     }

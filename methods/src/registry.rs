@@ -125,6 +125,11 @@ pub fn table1_method(side: Table1Side) -> Option<&'static MethodEntry> {
     METHODS.iter().find(|m| m.table1 == Some(side))
 }
 
+/// The side of HIRM's Table 1 of the registered method `name` (none for other names).
+pub fn table1_side(name: &str) -> Option<Table1Side> {
+    find(name).ok().and_then(|m| m.table1)
+}
+
 /// Names of all registered methods.
 pub fn method_names() -> Vec<&'static str> {
     METHODS.iter().map(|m| m.name).collect()

@@ -103,10 +103,7 @@ pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, H
     }
     let handle_scenarios: Vec<&CaseResult> = results
         .iter()
-        .filter(|r| {
-            r.scenario.ends_with("-handles")
-                && methods::registry::find(&r.method).is_ok_and(|m| m.table1.is_some())
-        })
+        .filter(|r| r.scenario.ends_with("-handles") && methods::registry::table1_side(&r.method).is_some())
         .collect();
     if !handle_scenarios.is_empty() {
         written.extend(save(dir, "table1", &Plot::Table1(&handle_scenarios))?);
@@ -821,7 +818,7 @@ fn draw_table1<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResult]) ->
         c.steps
             .iter()
             .filter_map(|s| {
-                let side = methods::registry::find(&c.method).ok().and_then(|m| m.table1);
+                let side = methods::registry::table1_side(&c.method);
                 let seconds = if side == Some(methods::registry::Table1Side::HandleIndependent) {
                     s.phase_timings
                         .iter()

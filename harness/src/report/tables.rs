@@ -1,7 +1,7 @@
-//! Writing reports: `results.csv`, `results.json`, `convergence.csv`, the handle-update tables and
-//! the result meshes (OFF and GLB) of every case.
-//! Everything is rendered in memory first and each file is written atomically, so a failed run leaves
-//! the previous reports intact.
+//! Writing reports: `results.csv`, `results.json` (rendered by [`crate::stored_report`]),
+//! `convergence.csv`, the handle-update tables and the result meshes (OFF and GLB) of every case.
+//! Each file is rendered in memory first and written atomically; the whole directory is swapped in
+//! at the end of a run ([`crate::staged_dir`]), so a failed run leaves the previous reports intact.
 
 use std::path::Path;
 
@@ -186,7 +186,7 @@ pub fn render_table1(results: &[CaseResult]) -> String {
     );
     let stat =
         |r: &CaseResult, name: &str| phase(&r.statistics, name).map_or("-".to_string(), |v| format!("{v}"));
-    let side = |r: &CaseResult| methods::registry::find(&r.method).ok().and_then(|m| m.table1);
+    let side = |r: &CaseResult| methods::registry::table1_side(&r.method);
     for hirm in results.iter().filter(|r| side(r) == Some(Table1Side::HandleIndependent)) {
         let Some(isolines) =
             results.iter().find(|r| side(r) == Some(Table1Side::Rebuilt) && r.scenario == hirm.scenario)
