@@ -41,8 +41,8 @@ use crate::laplacian_coordinates::{DeltaFrame, RotationInvariantCoordinates};
 use crate::linalg::anderson::{Acceleration, FixedPointIteration, MAX_DEPTH};
 use crate::linalg::sparse_cholesky::{add_to_diagonal, SparseCholesky};
 use crate::method::{
-    move_to, require_phase, run_iterations, DeformationMethod, IterationObserver, Iterations, Phase,
-    SolveSummary,
+    move_to, require_phase, run_iterations, DeformationMethod, DistanceBound, IterationObserver, Iterations,
+    Phase, SolveSummary,
 };
 use crate::operators::{laplacian, LaplacianWeights};
 
@@ -54,7 +54,8 @@ pub struct LaplacianParams {
     pub omega: f64,
     /// Iteration limit per solve.
     pub max_iterations: usize,
-    /// Converged when the largest vertex step falls below `tolerance x bbox diagonal`.
+    /// Converged when the estimated distance to the fixed point (`crate::method::DistanceBound`,
+    /// from the step sequence) falls below `tolerance x bbox diagonal`.
     pub tolerance: f64,
     /// Weights of `L` (see the module documentation).
     pub weights: LaplacianWeights,
@@ -210,7 +211,7 @@ impl DeformationMethod for LaplacianEditing {
             self.params.anderson_depth,
             3 * self.current.len(),
         );
-        let iterate = |m: &mut Self, iteration: usize| -> Result<f64, MethodError> {
+        let iterate = |m: &mut Self, iteration: usize, rule: &DistanceBound| -> Result<f64, MethodError> {
             m.update_delta();
             let rest = m.rest.as_ref().expect("bound implies precomputed");
             let handles = m.handles.as_ref().expect("checked above");
@@ -231,7 +232,7 @@ impl DeformationMethod for LaplacianEditing {
             // G(X) into `image`, checked; the plain step |G(X) - X| is what converges.
             m.image.copy_from_slice(&m.current);
             let step = move_to("laplacian", iteration, &mut m.image, m.rhs.as_ref())? / rest.bbox_diagonal;
-            fixed_point.advance(m.current.as_flattened_mut(), m.image.as_flattened(), step < tolerance);
+            fixed_point.advance(m.current.as_flattened_mut(), m.image.as_flattened(), rule.is_met_by(step));
             Ok(step)
         };
         let summary = run_iterations(iterations, self, iterate, |m| m.current.clone(), observer)?;

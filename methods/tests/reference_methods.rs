@@ -184,7 +184,7 @@ fn anderson_arap_reaches_the_plain_fixed_point_in_fewer_iterations() {
     let targets = bar.handle_moved_by(&handles, &bar.edit);
     let run = |acceleration: &str, iterations: usize, tolerance: f64| {
         let text = format!(
-            "max_iterations = {iterations}\ntolerance = {tolerance:e}\nacceleration = \"{acceleration}\"\nstart = \"current\""
+            "solver = \"local_global\"\nmax_iterations = {iterations}\ntolerance = {tolerance:e}\nacceleration = \"{acceleration}\"\nstart = \"current\""
         );
         let mut arap = create("arap", &params(&text)).unwrap();
         arap.precompute(mesh).unwrap();
@@ -220,7 +220,9 @@ fn arap_started_by_transformation_propagation_converges_in_fewer_iterations() {
     let (mesh, handles) = (&bar.mesh, bar.handles());
     let diagonal = mesh.bbox_diagonal();
     let solve = |start: &str, iterations: usize, targets: &HandleTargets| {
-        let text = format!("max_iterations = {iterations}\ntolerance = 1e-9\nstart = \"{start}\"");
+        let text = format!(
+            "solver = \"local_global\"\nmax_iterations = {iterations}\ntolerance = 1e-9\nstart = \"{start}\""
+        );
         let mut arap = create("arap", &params(&text)).unwrap();
         arap.precompute(mesh).unwrap();
         arap.bind_handles(&handles).unwrap();

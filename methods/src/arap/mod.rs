@@ -48,6 +48,7 @@
 //! by identity (same pattern, so the symbolic analysis is reused for any handle set); each iteration is
 //! one local step, one right-hand side assembly and one back-substitution of 3 columns.
 
+mod quasi_newton;
 mod transformation_propagation;
 
 use faer::sparse::SparseColMat;
@@ -61,8 +62,8 @@ use crate::handles::{HandleSet, HandleTargets, FREE};
 use crate::linalg::anderson::{Acceleration, AndersonAcceleration, RESIDUAL_GROWTH_LIMIT};
 use crate::linalg::sparse_cholesky::SparseCholesky;
 use crate::method::{
-    move_to, require_phase, run_iterations, DeformationMethod, IterationObserver, Iterations, Phase,
-    SolveSummary,
+    move_to, require_phase, run_iterations, DeformationMethod, DistanceBound, IterationObserver, Iterations,
+    Phase, SolveSummary,
 };
 use crate::operators::{laplacian, LaplacianWeights};
 use crate::rotation_fit::{closest_rotation_warm, Mat3};
@@ -73,7 +74,8 @@ use crate::rotation_fit::{closest_rotation_warm, Mat3};
 pub struct ArapParams {
     /// Iteration limit per solve.
     pub max_iterations: usize,
-    /// Converged when the largest vertex step falls below `tolerance x bbox diagonal`.
+    /// Converged when the estimated distance to the fixed point (`crate::method::DistanceBound`,
+    /// from the step sequence) falls below `tolerance x bbox diagonal`.
     pub tolerance: f64,
     /// Spokes, weights and global-step matrix (see the module documentation, "Weights").
     pub weights: LaplacianWeights,
@@ -83,6 +85,24 @@ pub struct ArapParams {
     pub anderson_depth: usize,
     /// The first iterate of every solve (see the module documentation).
     pub start: ArapStart,
+    /// `"lbfgs"` (quasi-Newton on the ARAP energy, [`quasi_newton`]) or `"local_global"` (SA07's
+    /// alternation, accelerated as `acceleration` says). The same energy and fixed points.
+    pub solver: ArapSolver,
+    /// Curvature pairs L-BFGS keeps (`m` of Liu et al. 2017).
+    pub lbfgs_memory: usize,
+    /// Least scale `c` of L-BFGS's initial Hessian `c K` (in `(0, 1]`; see [`quasi_newton`]).
+    pub lbfgs_scale_floor: f64,
+}
+
+/// How an ARAP solve minimizes the energy.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ArapSolver {
+    /// L-BFGS with the factored global-step matrix as initial Hessian (Liu, Bouaziz & Kavan 2017).
+    #[default]
+    Lbfgs,
+    /// The local/global iteration of SA07 (libigl's `arap_solve`), optionally Anderson-accelerated.
+    LocalGlobal,
 }
 
 /// The first iterate of an ARAP solve.
@@ -105,6 +125,9 @@ impl Default for ArapParams {
             acceleration: Acceleration::default(),
             anderson_depth: 7,
             start: ArapStart::default(),
+            solver: ArapSolver::default(),
+            lbfgs_memory: 8,
+            lbfgs_scale_floor: 0.5,
         }
     }
 }
@@ -142,17 +165,76 @@ pub struct Arap {
     vertex_energies: Vec<f64>,
 }
 
+impl Spokes {
+    /// The spokes of `laplacian`'s off-diagonal pattern at `rest` (`#V x 3`) positions.
+    fn new(laplacian: &SparseColMat<usize, f64>, rest: &[[f64; 3]]) -> Self {
+        let n = rest.len();
+        let (symbolic, values) = laplacian.parts();
+        let mut offsets = Vec::with_capacity(n + 1);
+        let mut neighbors = Vec::new();
+        let mut weights = Vec::new();
+        let mut rest_edges = Vec::new();
+        offsets.push(0);
+        // L is symmetric, so column i lists row i's neighbours: the spokes of vertex i.
+        for i in 0..n {
+            for idx in symbolic.col_range(i) {
+                let j = symbolic.row_idx()[idx];
+                if j != i {
+                    neighbors.push(j as u32);
+                    weights.push(values[idx]);
+                    rest_edges.push(meshes::vector::sub(rest[i], rest[j]));
+                }
+            }
+            offsets.push(neighbors.len());
+        }
+        Self { offsets, neighbors, weights, rest_edges }
+    }
+}
+
+/// The ARAP energy of any shape on a rest mesh (SA07 eq 3 with the rotations of the local step),
+/// relative to the rest shape's Dirichlet energy `sum_ij w_ij |p_i - p_j|^2`: dimensionless, 0 for
+/// a rigid motion, the same for a uniformly scaled copy of the problem. The harness records it for
+/// every result, so that a method that reached a lower ARAP energy than the reference shows.
+pub struct ArapEnergy {
+    spokes: Spokes,
+    rest_dirichlet: f64,
+}
+
+impl ArapEnergy {
+    /// The energy with `weights` on `rest`.
+    pub fn new(rest: &TriMesh, weights: LaplacianWeights) -> Result<Self, MethodError> {
+        let laplacian = laplacian(weights, rest.positions(), rest.triangles())?;
+        let spokes = Spokes::new(&laplacian, rest.positions());
+        let rest_dirichlet =
+            spokes.weights.iter().zip(&spokes.rest_edges).map(|(w, e)| w * meshes::vector::dot(*e, *e)).sum();
+        Ok(Self { spokes, rest_dirichlet })
+    }
+
+    /// `E(X) / sum w |e|^2` for `#V x 3` positions `x` on the rest connectivity.
+    pub fn relative_energy(&self, x: &[[f64; 3]]) -> f64 {
+        let n = x.len();
+        let mut rotations = vec![[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]; n];
+        let mut frames = rotations.clone();
+        let mut per_vertex = vec![0.0; n];
+        Arap::local_step(&self.spokes, x, &mut rotations, &mut frames);
+        Arap::energy(&self.spokes, x, &rotations, &mut per_vertex) / self.rest_dirichlet
+    }
+}
+
 impl Arap {
     /// A method with the given parameters; call [`DeformationMethod::precompute`] next.
     pub fn new(params: ArapParams) -> Result<Self, MethodError> {
         if params.max_iterations == 0
             || !(params.tolerance >= 0.0)
             || params.anderson_depth > crate::linalg::anderson::MAX_DEPTH
+            || params.lbfgs_memory > 64
+            || !(params.lbfgs_scale_floor > 0.0 && params.lbfgs_scale_floor <= 1.0)
         {
             return Err(MethodError::Parameters {
                 method: "arap",
                 message: format!(
-                    "max_iterations must be >= 1, tolerance >= 0 and anderson_depth <= {}",
+                    "max_iterations must be >= 1, tolerance >= 0, lbfgs_memory <= 64, lbfgs_scale_floor \
+                     in (0, 1] and anderson_depth <= {}",
                     crate::linalg::anderson::MAX_DEPTH
                 ),
             });
@@ -276,28 +358,11 @@ impl DeformationMethod for Arap {
         meshes::Topology::new(rest)?;
         let laplacian = laplacian(self.params.weights, rest.positions(), rest.triangles())?;
         let n = rest.n_vertices();
-        let (symbolic, values) = laplacian.parts();
-        let mut offsets = Vec::with_capacity(n + 1);
-        let mut neighbors = Vec::new();
-        let mut weights = Vec::new();
-        let mut rest_edges = Vec::new();
-        offsets.push(0);
-        // L is symmetric, so column i lists row i's neighbours: the spokes of vertex i.
-        for i in 0..n {
-            for idx in symbolic.col_range(i) {
-                let j = symbolic.row_idx()[idx];
-                if j != i {
-                    neighbors.push(j as u32);
-                    weights.push(values[idx]);
-                    rest_edges.push(meshes::vector::sub(rest.positions()[i], rest.positions()[j]));
-                }
-            }
-            offsets.push(neighbors.len());
-        }
+        let spokes = Spokes::new(&laplacian, rest.positions());
         let stiffness = crate::operators::stiffness(laplacian);
         self.cholesky = Some(SparseCholesky::analyze(stiffness.as_ref())?);
         self.stiffness = Some(stiffness);
-        self.spokes = Some(Spokes { offsets, neighbors, weights, rest_edges });
+        self.spokes = Some(spokes);
         self.rest = rest.positions().to_vec();
         self.bbox_diagonal = rest.bbox_diagonal();
         self.current = self.rest.clone();
@@ -373,6 +438,23 @@ impl DeformationMethod for Arap {
             cholesky.solve_in_place(self.rhs.as_mut());
             move_to("arap", 0, &mut self.current, self.rhs.as_ref())?;
         }
+        let (tolerance, diagonal) = (self.params.tolerance, self.bbox_diagonal);
+        let iterations = Iterations { first: 0, count: self.params.max_iterations, tolerance };
+        if self.params.solver == ArapSolver::Lbfgs {
+            let solver = quasi_newton::QuasiNewton {
+                spokes,
+                region_of,
+                cholesky,
+                rotations: &mut self.rotations,
+                frames: &mut self.singular_frames,
+                vertex_energies: &mut self.vertex_energies,
+                rhs: &mut self.rhs,
+                memory: self.params.lbfgs_memory,
+                scale_floor: self.params.lbfgs_scale_floor,
+                diagonal,
+            };
+            return solver.solve(iterations, &mut self.current, observer);
+        }
         let accelerated =
             self.params.acceleration == Acceleration::Anderson && self.params.anderson_depth > 0;
         let mut anderson = AndersonAcceleration::new(
@@ -382,10 +464,11 @@ impl DeformationMethod for Arap {
         .with_residual_growth_limit(RESIDUAL_GROWTH_LIMIT);
         let mut previous_energy = f64::INFINITY;
         let mut has_image = false;
-        let (tolerance, diagonal) = (self.params.tolerance, self.bbox_diagonal);
-        let iterations = Iterations { first: 0, count: self.params.max_iterations, tolerance };
         // The state is the iterate X; the closure holds the rest of the method's buffers.
-        let iterate = |current: &mut Vec<[f64; 3]>, iteration: usize| -> Result<f64, MethodError> {
+        let iterate = |current: &mut Vec<[f64; 3]>,
+                       iteration: usize,
+                       rule: &DistanceBound|
+         -> Result<f64, MethodError> {
             Self::local_step(spokes, current, &mut self.rotations, &mut self.singular_frames);
             if accelerated {
                 // Peng et al.'s safeguard: an extrapolated iterate must not raise the energy.
@@ -413,7 +496,7 @@ impl DeformationMethod for Arap {
             self.image.copy_from_slice(current);
             let step = move_to("arap", iteration, &mut self.image, self.rhs.as_ref())? / diagonal;
             has_image = true;
-            if accelerated && step >= tolerance {
+            if accelerated && !rule.is_met_by(step) {
                 anderson.next(
                     current.as_flattened(),
                     self.image.as_flattened(),

@@ -242,6 +242,7 @@ impl DeformationMethod for ExternalMethod {
             iterations,
             converged: answer.converged.unwrap_or(true),
             final_step,
+            distance: answer.distance.unwrap_or(if self.spec.iterative { f64::NAN } else { 0.0 }),
             convergence_unknown: self.spec.iterative && answer.converged.is_none(),
         })
     }

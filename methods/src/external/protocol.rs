@@ -63,6 +63,10 @@ pub struct Answer {
     pub converged: Option<bool>,
     #[serde(default)]
     pub final_step: Option<f64>,
+    /// `solve`, optional: the method's own estimate of its answer's distance to its fixed point
+    /// (over the rest bounding-box diagonal), as the built-in methods report theirs.
+    #[serde(default)]
+    pub distance: Option<f64>,
     /// Any request: the method's own timings of that request, seconds by name.
     #[serde(default)]
     pub timings: BTreeMap<String, f64>,

@@ -105,7 +105,8 @@ use crate::isoline_model::{
 };
 use crate::linalg::anderson::{Acceleration, MAX_DEPTH};
 use crate::method::{
-    require_phase, run_iterations, DeformationMethod, IterationObserver, Iterations, Phase, SolveSummary,
+    require_phase, run_iterations, DeformationMethod, DistanceBound, IterationObserver, Iterations, Phase,
+    SolveSummary,
 };
 use crate::operators::{laplacian, lumped_mass_for, LaplacianWeights, MassKind};
 
@@ -133,7 +134,8 @@ pub struct HirmParams {
     pub fields_per_region: f64,
     /// Iteration limit per solve.
     pub max_iterations: usize,
-    /// Converged when the step falls below `tolerance x bbox diagonal`.
+    /// Converged when the estimated distance to the fixed point (`crate::method::DistanceBound`,
+    /// from the step sequence) falls below `tolerance x bbox diagonal`.
     pub tolerance: f64,
     /// Seed of the eigensolver's start vectors.
     pub seed: u64,
@@ -481,17 +483,18 @@ impl DeformationMethod for Hirm {
             self.params.anderson_depth,
             self.reduced.nrows(),
         );
-        let iterate = |reduced: &mut Mat<f64>, iteration: usize| -> Result<f64, MethodError> {
-            fixed_point.begin(reduced.as_ref());
-            // Eq 17-19, then eq 20 (eq 27 with T_2 = W^T L^T W_sigma R_sigma).
-            let rotations = model.isoline_rotations(&probes, RotationFit::ScaledOrthogonal);
-            let mut rhs = &system.laplacian_rhs * &rotations;
-            rhs += &constraints;
-            let it = ReducedIteration { method: "hirm", iteration, model, factor };
-            let step = reduced_step(it, rhs, reduced, &mut probes, rest.bbox_diagonal)?;
-            fixed_point.advance("hirm", iteration, model, reduced, &mut probes, step < tolerance)?;
-            Ok(step)
-        };
+        let iterate =
+            |reduced: &mut Mat<f64>, iteration: usize, rule: &DistanceBound| -> Result<f64, MethodError> {
+                fixed_point.begin(reduced.as_ref());
+                // Eq 17-19, then eq 20 (eq 27 with T_2 = W^T L^T W_sigma R_sigma).
+                let rotations = model.isoline_rotations(&probes, RotationFit::ScaledOrthogonal);
+                let mut rhs = &system.laplacian_rhs * &rotations;
+                rhs += &constraints;
+                let it = ReducedIteration { method: "hirm", iteration, model, factor };
+                let step = reduced_step(it, rhs, reduced, &mut probes, rest.bbox_diagonal)?;
+                fixed_point.advance("hirm", iteration, model, reduced, &mut probes, rule.is_met_by(step))?;
+                Ok(step)
+            };
         let shape = |reduced: &Mat<f64>| model.positions(reduced.as_ref());
         let summary = run_iterations(iterations, &mut self.reduced, iterate, shape, observer)?;
         if !summary.converged {

@@ -67,7 +67,8 @@ use crate::isoline_model::{
 use crate::laplacian_coordinates::{DeltaFrame, RotationInvariantCoordinates};
 use crate::linalg::anderson::{Acceleration, MAX_DEPTH};
 use crate::method::{
-    require_phase, run_iterations, DeformationMethod, IterationObserver, Iterations, Phase, SolveSummary,
+    require_phase, run_iterations, DeformationMethod, DistanceBound, IterationObserver, Iterations, Phase,
+    SolveSummary,
 };
 use crate::operators::{laplacian, LaplacianWeights};
 
@@ -100,7 +101,8 @@ pub struct IsolinesParams {
     pub laplacian_coordinates: LaplacianCoordinates,
     /// Iteration limit per solve.
     pub max_iterations: usize,
-    /// Converged when the step falls below `tolerance x bbox diagonal`.
+    /// Converged when the estimated distance to the fixed point (`crate::method::DistanceBound`,
+    /// from the step sequence) falls below `tolerance x bbox diagonal`.
     pub tolerance: f64,
     /// Weights of `L` (see the module documentation).
     pub weights: LaplacianWeights,
@@ -299,7 +301,10 @@ impl DeformationMethod for Isolines {
             self.params.anderson_depth,
             self.reduced.nrows(),
         );
-        let iterate = |reduced: &mut Mat<f64>, iteration: usize| -> Result<f64, MethodError> {
+        let iterate = |reduced: &mut Mat<f64>,
+                       iteration: usize,
+                       rule: &DistanceBound|
+         -> Result<f64, MethodError> {
             fixed_point.begin(reduced.as_ref());
             let mut rhs = constraint_rhs.clone();
             match &mut bound.coordinates {
@@ -320,7 +325,7 @@ impl DeformationMethod for Isolines {
             let it =
                 ReducedIteration { method: name, iteration, model: &bound.model, factor: bound.factor.L() };
             let step = reduced_step(it, rhs, reduced, &mut probes, rest.bbox_diagonal)?;
-            fixed_point.advance(name, iteration, &bound.model, reduced, &mut probes, step < tolerance)?;
+            fixed_point.advance(name, iteration, &bound.model, reduced, &mut probes, rule.is_met_by(step))?;
             Ok(step)
         };
         let shape = |reduced: &Mat<f64>| bound.model.positions(reduced.as_ref());

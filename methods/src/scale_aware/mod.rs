@@ -84,8 +84,8 @@ use crate::handles::{HandleSet, HandleTargets};
 use crate::laplacian::{LaplacianEditing, LaplacianParams};
 use crate::laplacian_coordinates::DeltaFrame;
 use crate::method::{
-    max_displacement, move_to, require_phase, run_iterations, DeformationMethod, IterationObserver,
-    IterationReport, Iterations, NoObserver, Phase, ReusedSolve, SolveSummary,
+    max_displacement, move_to, require_phase, run_iterations, DeformationMethod, DistanceBound,
+    IterationObserver, IterationReport, Iterations, NoObserver, Phase, ReusedSolve, SolveSummary,
 };
 use crate::operators::LaplacianWeights;
 use crate::rotation_fit::Mat3;
@@ -100,8 +100,8 @@ pub struct ScaleAwareParams {
     pub constraint_weight: f64,
     /// Limit on the outer iterations of Algorithm 1 per solve.
     pub max_iterations: usize,
-    /// Converged when the plain outer iteration `T` would move no vertex by more than
-    /// `tolerance x bbox diagonal` (the fixed-point residual `|T(x) - x|`).
+    /// Converged when the estimated distance to the fixed point (`crate::method::DistanceBound`
+    /// over the fixed-point residuals `|T(x) - x|`) falls below `tolerance x bbox diagonal`.
     pub tolerance: f64,
     /// Limit on the local/global iterations of step one per outer iteration (the paper: "usually
     /// 5–20").
@@ -325,8 +325,13 @@ impl ScaleAware {
         let step = max_displacement(&before, &self.current) / diagonal;
         let report = IterationReport { iteration: 0, step, seconds: self.timings.initialization };
         let current: &[[f64; 3]] = &self.current;
-        let summary =
-            SolveSummary { iterations: 1, converged: false, final_step: step, convergence_unknown: false };
+        let summary = SolveSummary {
+            iterations: 1,
+            converged: false,
+            final_step: step,
+            distance: f64::INFINITY,
+            convergence_unknown: false,
+        };
         if observer.on_iteration(&report, Some(&|| current.to_vec())) == ControlFlow::Break(()) {
             return Ok(summary);
         }
@@ -335,7 +340,7 @@ impl ScaleAware {
         let mut anderson = AndersonAcceleration::new(self.params.anderson_depth, 3 * self.current.len());
         let iterations =
             Iterations { first: 1, count: self.params.max_iterations, tolerance: self.params.tolerance };
-        let iterate = |m: &mut Self, iteration: usize| -> Result<f64, MethodError> {
+        let iterate = |m: &mut Self, iteration: usize, rule: &DistanceBound| -> Result<f64, MethodError> {
             let start = Instant::now();
             m.update_normals();
             m.timings.step_one_normals += start.elapsed().as_secs_f64();
@@ -343,7 +348,7 @@ impl ScaleAware {
             m.timings.outer_iterations += 1;
             // The fixed-point residual |T(x) - x| is the plain iteration's step.
             let residual = max_displacement_to(&m.current, m.solution.as_ref()) / diagonal;
-            if residual >= m.params.tolerance && m.params.anderson_depth > 0 {
+            if !rule.is_met_by(residual) && m.params.anderson_depth > 0 {
                 m.accelerate(&mut anderson);
             }
             move_to(m.name, iteration, &mut m.current, m.solution.as_ref())?;
@@ -530,7 +535,7 @@ impl DeformationMethod for ScaleAware {
         let diagonal = self.rest.as_ref().expect("bound implies precomputed").bbox_diagonal;
         // The stitching step is no convergence test: a tolerance of infinity never fails it.
         let stitching = Iterations { first: summary.iterations, count: 1, tolerance: f64::INFINITY };
-        let stitch = |m: &mut Self, iteration: usize| -> Result<f64, MethodError> {
+        let stitch = |m: &mut Self, iteration: usize, _: &DistanceBound| -> Result<f64, MethodError> {
             let start = Instant::now();
             m.approximate_rigidity(targets)?;
             let step = move_to(m.name, iteration, &mut m.current, m.solution.as_ref())? / diagonal;

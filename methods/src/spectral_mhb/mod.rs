@@ -466,7 +466,14 @@ impl DeformationMethod for SpectralMhb {
         let report = IterationReport { iteration: 0, step, seconds: start.elapsed().as_secs_f64() };
         let current = &self.current;
         let _ = observer.on_iteration(&report, Some(&|| current.clone()));
-        Ok(SolveSummary { iterations: 1, converged: true, final_step: step, convergence_unknown: false })
+        // A direct solve: the answer is the fixed point.
+        Ok(SolveSummary {
+            iterations: 1,
+            converged: true,
+            final_step: step,
+            distance: 0.0,
+            convergence_unknown: false,
+        })
     }
 
     fn positions(&self) -> Vec<[f64; 3]> {
