@@ -226,6 +226,7 @@ pub fn run_case(
                     iterations: summary.iterations,
                     cap,
                     last_step: summary.final_step,
+                    distance: summary.distance,
                     tolerance,
                 });
             }
@@ -238,6 +239,7 @@ pub fn run_case(
                 iterations: summary.iterations,
                 converged: summary.converged,
                 final_step: summary.final_step,
+                fixed_point_distance: summary.distance,
                 median_iteration_ms: median_ms(&recorder.trace[first_iteration..]),
                 reused_solve_s,
                 phase_timings: m.phase_timings(),
@@ -245,6 +247,7 @@ pub fn run_case(
             final_edit = Some((step, targets));
         }
         result.converged = result.steps.iter().all(|s| s.converged);
+        result.fixed_point_distance = result.steps.iter().map(|s| s.fixed_point_distance).fold(0.0, nan_max);
         let positions = m.positions();
         result.bind_s = result.steps.first().map_or(f64::NAN, |s| s.bind_s);
         result.solve_s = solve_s;
@@ -301,6 +304,15 @@ pub fn run_case(
         Err(e) => Status::Failed(e.to_string()),
     };
     result
+}
+
+/// The larger of `a` and `b`, NaN if either is (an unknown distance stays unknown).
+fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
 }
 
 /// Fold the later repetitions of a case (rounds 2..N of `--repeat N`, from [`repetition`]) into

@@ -77,6 +77,10 @@ pub struct StepRecord {
     /// method's tolerance).
     #[serde(default = "nan", deserialize_with = "nan_from_null")]
     pub final_step: f64,
+    /// The method's estimate of its answer's distance to its fixed point over the rest diagonal
+    /// ([`methods::DistanceBound`]; `converged` compared it with the tolerance). NaN: not reported.
+    #[serde(default = "nan", deserialize_with = "nan_from_null")]
+    pub fixed_point_distance: f64,
     #[serde(deserialize_with = "nan_from_null")]
     pub median_iteration_ms: f64,
     /// Seconds of `solve_s` that the method took from an identical solve of another method's case
@@ -136,6 +140,10 @@ pub struct CaseResult {
     #[serde(default = "nan", deserialize_with = "nan_from_null")]
     pub peak_memory_mib: f64,
     pub converged: bool,
+    /// The largest of the edit steps' estimated distances to the fixed point over the rest
+    /// diagonal (NaN: not reported; 0: a direct method).
+    #[serde(default = "nan", deserialize_with = "nan_from_null")]
+    pub fixed_point_distance: f64,
     /// An iterative method that did not say whether it converged (external `kind = "iterative"`):
     /// `converged` is then only "finished", and the case is `suspect: convergence unknown`.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
@@ -345,6 +353,7 @@ impl CaseResult {
             total_s: f64::NAN,
             peak_memory_mib: f64::NAN,
             converged: false,
+            fixed_point_distance: f64::NAN,
             convergence_unknown: false,
             quality: Quality::default(),
             largest_move_over_diag: f64::NAN,

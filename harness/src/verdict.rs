@@ -186,6 +186,9 @@ pub struct Unfinished {
     pub cap: Option<usize>,
     /// The last iteration's step over the rest diagonal, and the method's tolerance if it has one.
     pub last_step: f64,
+    /// The estimated distance of the answer to the fixed point over the rest diagonal (what the
+    /// tolerance bounds; [`methods::DistanceBound`]).
+    pub distance: f64,
     pub tolerance: Option<f64>,
 }
 
@@ -207,6 +210,11 @@ impl fmt::Display for Unfinished {
             _ => write!(f, "stopped after {} iterations without converging", self.iterations)?,
         }
         write!(f, ", last step {:.1e} of the diagonal", self.last_step)?;
+        if self.distance.is_finite() {
+            write!(f, ", estimated {:.1e} from the fixed point", self.distance)?;
+        } else if !self.distance.is_nan() {
+            write!(f, ", steps not contracting")?;
+        }
         if let Some(t) = self.tolerance {
             write!(f, " (tolerance {t:.0e})")?;
         }
@@ -490,6 +498,7 @@ mod tests {
             iterations: 500,
             cap: Some(500),
             last_step: 3.04e-4,
+            distance: 6.1e-3,
             tolerance: Some(1e-5),
         };
         let s =
@@ -497,7 +506,8 @@ mod tests {
         assert!(s.is_unfinished() && s.kind() == "unfinished");
         assert_eq!(
             s.to_string(),
-            "unfinished: stopped at the 500-iteration cap, last step 3.0e-4 of the diagonal (tolerance 1e-5); \
+            "unfinished: stopped at the 500-iteration cap, last step 3.0e-4 of the diagonal, estimated 6.1e-3 \
+             from the fixed point (tolerance 1e-5); \
              folds: 0.010% of interior edges turned by more than 90°"
         );
         assert_eq!(s.shape_reasons().count(), 1, "the fold, not the cap");

@@ -30,6 +30,7 @@ const CASE_COLUMNS: &[&str] = &[
     "solve_s",
     "total_s",
     "converged",
+    "fixed_point_distance",
     "repetitions",
     "precompute_s_min",
     "precompute_s_max",
@@ -92,6 +93,7 @@ pub fn render_csv(results: &[CaseResult]) -> Result<Vec<u8>, HarnessError> {
             num(r.solve_s),
             num(r.total_s),
             if r.convergence_unknown { "unknown".to_string() } else { r.converged.to_string() },
+            num(r.fixed_point_distance),
         ];
         let spread = r.spread.unwrap_or_default();
         row.push(spread.repetitions.to_string());
