@@ -84,3 +84,34 @@ class Stopwatch:
 
     def __exit__(self, *exc):
         self.seconds = time.perf_counter() - self.start
+
+
+class DistanceBound:
+    """The built-in methods' stopping rule (methods/src/method.rs, `DistanceBound`): after each step
+    `s_k` (largest vertex move over the diagonal), the estimated distance to the fixed point is
+    `s_k rho / (1 - rho)`, `rho` the largest ratio of successive steps over the last four; until
+    four steps are recorded, or while a step grew, `rho` is taken as 0.999. Report the value as the
+    answer's `distance` and stop when it falls below the tolerance."""
+
+    WINDOW = 4
+    SLOWEST = 0.999
+
+    def __init__(self):
+        self.steps = []
+
+    def record(self, step):
+        """Record `step`; returns the distance bound after it."""
+        if step == 0.0:
+            distance = 0.0
+        elif not np.isfinite(step):
+            distance = float("inf")
+        else:
+            distance = step * self.SLOWEST / (1.0 - self.SLOWEST)
+            if len(self.steps) >= self.WINDOW:
+                recent = self.steps[-self.WINDOW:] + [step]
+                ratios = [b / a if a > 0.0 else float("inf") for a, b in zip(recent, recent[1:])]
+                rho = max(ratios)
+                if rho < 1.0:
+                    distance = step * rho / (1.0 - rho)
+        self.steps = (self.steps + [step])[-(self.WINDOW + 1):]
+        return distance

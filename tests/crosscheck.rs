@@ -170,9 +170,10 @@ impl ArapCase {
 
     /// Our `arap` after exactly `iterations` iterations (no early exit), from the rest shape.
     fn our_arap(&self, iterations: usize) -> Vec<[f64; 3]> {
-        // libigl's arap uses the mesh's cotangent weights.
+        // libigl's arap uses the mesh's cotangent weights and the plain local/global iteration.
         let params: toml::Table = format!(
-            "max_iterations = {iterations}\ntolerance = 0.0\nweights = \"cotan\"\nacceleration = \"none\"\nstart = \"current\""
+            "max_iterations = {iterations}\ntolerance = 0.0\nweights = \"cotan\"\nsolver = \"local_global\"\n\
+             acceleration = \"none\"\nstart = \"current\""
         )
         .parse()
         .unwrap();

@@ -247,11 +247,21 @@ fn peers_run_beside_arap_and_land_near_it() {
         assert_eq!(r["origin"], "peer", "{}", r["method"]);
         assert!(!r["status"].starts_with("failed"), "{}: {}", r["method"], r["status"]);
     }
-    // The same energy to the same tolerance: the same shape, up to the weights (ours are the
-    // intrinsic Delaunay cotangents) and libigl's single-precision rotation fit.
+    // The same energy to the same distance bound: the same stationary point up to the weights
+    // (ours are the intrinsic Delaunay cotangents) and libigl's single-precision rotation fit, or a
+    // lower one. On this bar the symmetric twist is a saddle of the energy (docs/results.md, issue
+    // 51): our L-BFGS converges to it, the plain local/global iteration leaves it after ~1000
+    // iterations for a buckled shape of lower energy. Then the page names libigl's lower energy.
     let libigl = row(&rows, "libigl_arap");
-    assert!(support::num(libigl, "rms_to_arap_over_diag") < 1e-3, "{}", libigl["rms_to_arap_over_diag"]);
     assert_eq!(libigl["converged"], "true");
+    let distance = support::num(libigl, "rms_to_arap_over_diag");
+    let page = std::fs::read_to_string(reports.join("index.html")).unwrap();
+    if distance >= 1e-3 {
+        let (theirs, ours) = (support::num(libigl, "arap_energy"), support::num(row(&rows, "arap"), "arap_energy"));
+        assert!(theirs < ours * (1.0 - 1e-3), "{distance:e} apart, yet not lower: {theirs:e} vs {ours:e}");
+        let listed = page.split("id=\"lower-energy\"").nth(1).unwrap_or_default();
+        assert!(listed.contains("<code>libigl_arap</code> on <code>bar</code>"), "{listed}");
+    }
     // Linear: a twist it cannot follow without rotations.
     assert!(
         support::num(row(&rows, "libigl_biharmonic"), "e_theta_deg")
@@ -267,7 +277,6 @@ fn peers_run_beside_arap_and_land_near_it() {
         .any(|e| e["method"] == "libigl_arap" && e["about"].as_str().unwrap().contains("libigl 2.6.3")));
     let peers = std::fs::read_to_string(reports.join("peers.md")).unwrap();
     assert!(peers.contains("| bar | "), "{peers}");
-    let page = std::fs::read_to_string(reports.join("index.html")).unwrap();
     assert!(page.contains("Our arap against libigl's") && page.contains("<span class=\"origin\""));
 
     // Without the Python the run says so and runs the rest.

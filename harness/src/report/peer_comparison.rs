@@ -99,8 +99,9 @@ pub fn render_markdown(rows: &[ArapAgainstLibigl]) -> String {
         return String::new();
     }
     let mut out = format!(
-        "# Our ARAP against libigl's\n\nAll three run the spokes energy to a step below 1e-5 of the rest diagonal \
-         (libigl one iteration per call). `{REFERENCE_METHOD}` has our default weights (intrinsic Delaunay cotangents), \
+        "# Our ARAP against libigl's\n\nAll three run the spokes energy until the estimated distance to the fixed point \
+         is below 1e-5 of the rest diagonal (ours by L-BFGS, libigl's plain local/global iteration one iteration per \
+         call). `{REFERENCE_METHOD}` has our default weights (intrinsic Delaunay cotangents), \
          `{LIKE_FOR_LIKE_REFERENCE}` libigl's (plain cotangents): the like-for-like comparison. Time = bind + solve of \
          every edit step (libigl's `arap_precomputation` needs the handles, so it is bind); ratio = ours / libigl's, \
          below 1 ours is faster. Distance = RMS of libigl's result from ours / rest diagonal. A `*` marks a row \
