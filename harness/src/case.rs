@@ -12,6 +12,7 @@ use crate::record::{
     records_quality, CaseResult, IterationRecord, ReusedSolveRecord, Spread, StepRecord, TimingSpread,
 };
 use crate::scenario::LoadedScenario;
+use crate::step_trend::StepTrend;
 use crate::verdict::{Motion, Status, Unfinished, VerdictRules};
 use methods::{IterationObserver, IterationReport};
 
@@ -228,6 +229,10 @@ pub fn run_case(
                     last_step: summary.final_step,
                     distance: summary.distance,
                     tolerance,
+                    trend: tolerance.and_then(|t| {
+                        let steps: Vec<f64> = recorder.trace[first_iteration..].iter().map(|r| r.step).collect();
+                        StepTrend::of(&steps, t)
+                    }),
                 });
             }
             result.steps.push(StepRecord {

@@ -14,7 +14,8 @@
 //! case, self_intersection        run one case through its phases; open3d's check of a result
 //! stored_report, regression, pareto   records on disk (results.json), the gate, the fronts
 //! record, provenance             the run's record: what each case measured; where and how it ran
-//! config, scenario, shard, sweep, metrics, verdict   what a run is made of, measures, verdict rules
+//! config, scenario, shard, sweep, metrics, verdict, step_trend   what a run is made of, measures,
+//!                                verdict rules, why an iteration did not finish
 //! paths, error, threads, variables, memory, staged_dir   the workspace, errors, threads, ${VAR},
 //!                                RSS, a directory replaced whole
 //! ```
@@ -38,6 +39,7 @@ pub mod scenario;
 pub mod self_intersection;
 pub mod shard;
 pub mod staged_dir;
+pub mod step_trend;
 pub mod stored_report;
 pub mod suite;
 pub mod sweep;

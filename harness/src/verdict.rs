@@ -15,6 +15,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::error::HarnessError;
 use crate::metrics::{Metric, Quality};
+use crate::step_trend::StepTrend;
 
 /// The kinds of shape reasons [`VerdictRules::reasons`] gives, each the start of its text (the
 /// dataset report counts cases per kind).
@@ -190,6 +191,8 @@ pub struct Unfinished {
     /// tolerance bounds; [`methods::DistanceBound`]).
     pub distance: f64,
     pub tolerance: Option<f64>,
+    /// What the last steps were doing ([`StepTrend`]), from the step's iteration trace.
+    pub trend: Option<StepTrend>,
 }
 
 impl Unfinished {
@@ -217,6 +220,9 @@ impl fmt::Display for Unfinished {
         }
         if let Some(t) = self.tolerance {
             write!(f, " (tolerance {t:.0e})")?;
+        }
+        if let Some(trend) = self.trend {
+            write!(f, ", {trend}")?;
         }
         Ok(())
     }
@@ -500,6 +506,7 @@ mod tests {
             last_step: 3.04e-4,
             distance: 6.1e-3,
             tolerance: Some(1e-5),
+            trend: None,
         };
         let s =
             Status::judge(&[capped], vec!["folds: 0.010% of interior edges turned by more than 90°".into()]);
@@ -511,6 +518,13 @@ mod tests {
              folds: 0.010% of interior edges turned by more than 90°"
         );
         assert_eq!(s.shape_reasons().count(), 1, "the fold, not the cap");
+        let swinging = Unfinished { trend: Some(StepTrend::Oscillating { low: 1e-4, high: 2e-3 }), ..capped };
+        assert!(
+            swinging.to_string().ends_with("(tolerance 1e-5), oscillating (steps 1.0e-4 to 2.0e-3 without a trend)"),
+            "{swinging}"
+        );
+        let parsed: Status = Status::judge(&[swinging], vec![]).to_string().parse().unwrap();
+        assert_eq!(parsed.shape_reasons().count(), 0, "the trend belongs to the unfinished reason");
         let second = Unfinished { step: 2, steps: 3, iterations: 40, cap: Some(500), ..capped };
         let both = Status::judge(&[capped, second], vec![]);
         assert_eq!(both.shape_reasons().count(), 0, "{both}");
