@@ -19,19 +19,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use harness::scenario::{load_spec, DataSource};
 use meshes::vector::{dot, sub};
-use methods::{IterationObserver, IterationReport, SolveSummary};
-
-struct Quiet;
-
-impl IterationObserver for Quiet {
-    fn on_iteration(
-        &mut self,
-        _: &IterationReport,
-        _: Option<&dyn Fn() -> Vec<[f64; 3]>>,
-    ) -> ControlFlow<()> {
-        ControlFlow::Continue(())
-    }
-}
+use methods::{IterationObserver, IterationReport, NoObserver, SolveSummary};
 
 /// TRACE=file with a cached reference: per iteration, the step and the true max distance to the
 /// reference over the diagonal (to study stopping rules offline).
@@ -84,7 +72,7 @@ fn solve(
     let targets = step.targets(&m.positions())?;
     m.bind_handles(&step.handles)?;
     let start = Instant::now();
-    let summary = m.solve(&targets, &mut Quiet)?;
+    let summary = m.solve(&targets, &mut NoObserver)?;
     Ok((m.positions(), summary, start.elapsed().as_secs_f64()))
 }
 
