@@ -224,12 +224,15 @@ pub struct DistanceBound {
     tolerance: f64,
     /// The last `CONTRACTION_WINDOW + 1` steps, oldest first.
     steps: Vec<f64>,
+    /// A lower estimate of the distance the iteration itself supplied for the step being recorded
+    /// ([`DistanceBound::at_least`]); taken by the next [`DistanceBound::record`].
+    floor: std::cell::Cell<f64>,
 }
 
 impl DistanceBound {
     /// A rule that is met once the bound falls below `tolerance` (same units as the steps).
     pub fn new(tolerance: f64) -> Self {
-        Self { tolerance, steps: Vec::with_capacity(CONTRACTION_WINDOW + 2) }
+        Self { tolerance, steps: Vec::with_capacity(CONTRACTION_WINDOW + 2), floor: std::cell::Cell::new(0.0) }
     }
 
     /// The bound after a further step `step`, without recording it.
@@ -264,9 +267,17 @@ impl DistanceBound {
         self.distance_after(step) < self.tolerance
     }
 
-    /// Record `step`; returns the bound after it.
+    /// An estimate of the current iterate's distance to the fixed point that the iteration has
+    /// from elsewhere than its steps (`arap`'s L-BFGS: its gradient over the least curvature it
+    /// has seen): the next recorded distance is at least `distance`, so a step sequence that looks
+    /// converged does not end a solve whose gradient says otherwise.
+    pub fn at_least(&self, distance: f64) {
+        self.floor.set(self.floor.get().max(distance));
+    }
+
+    /// Record `step`; returns the bound after it (at least the floor set since the last record).
     pub fn record(&mut self, step: f64) -> f64 {
-        let distance = self.distance_after(step);
+        let distance = self.distance_after(step).max(self.floor.replace(0.0));
         if self.steps.len() > CONTRACTION_WINDOW {
             self.steps.remove(0);
         }
@@ -408,5 +419,9 @@ mod tests {
             rule.record(step);
         }
         assert_eq!(rule.distance_after(0.5), 0.5);
+        // A floor from elsewhere (the gradient) holds for the next record only.
+        rule.at_least(2.0);
+        assert_eq!(rule.record(0.5), 2.0);
+        assert_eq!(rule.record(0.25), 0.25);
     }
 }
