@@ -257,7 +257,8 @@ fn peers_run_beside_arap_and_land_near_it() {
     let distance = support::num(libigl, "rms_to_arap_over_diag");
     let page = std::fs::read_to_string(reports.join("index.html")).unwrap();
     if distance >= 1e-3 {
-        let (theirs, ours) = (support::num(libigl, "arap_energy"), support::num(row(&rows, "arap"), "arap_energy"));
+        let (theirs, ours) =
+            (support::num(libigl, "arap_energy"), support::num(row(&rows, "arap"), "arap_energy"));
         assert!(theirs < ours * (1.0 - 1e-3), "{distance:e} apart, yet not lower: {theirs:e} vs {ours:e}");
         let listed = page.split("id=\"lower-energy\"").nth(1).unwrap_or_default();
         assert!(listed.contains("<code>libigl_arap</code> on <code>bar</code>"), "{listed}");

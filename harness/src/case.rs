@@ -230,7 +230,8 @@ pub fn run_case(
                     distance: summary.distance,
                     tolerance,
                     trend: tolerance.and_then(|t| {
-                        let steps: Vec<f64> = recorder.trace[first_iteration..].iter().map(|r| r.step).collect();
+                        let steps: Vec<f64> =
+                            recorder.trace[first_iteration..].iter().map(|r| r.step).collect();
                         StepTrend::of(&steps, t)
                     }),
                 });

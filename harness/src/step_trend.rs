@@ -57,7 +57,8 @@ impl StepTrend {
         let sxx: f64 = points.iter().map(|p| (p.0 - mean_x).powi(2)).sum();
         let sxy: f64 = points.iter().map(|p| (p.0 - mean_x) * (p.1 - mean_y)).sum();
         let slope = sxy / sxx;
-        let spread = (points.iter().map(|p| (p.1 - mean_y - slope * (p.0 - mean_x)).powi(2)).sum::<f64>() / n).sqrt();
+        let spread =
+            (points.iter().map(|p| (p.1 - mean_y - slope * (p.0 - mean_x)).powi(2)).sum::<f64>() / n).sqrt();
         let rho = slope.exp();
         let (low, high) = window
             .iter()
@@ -100,7 +101,9 @@ impl fmt::Display for StepTrend {
             StepTrend::Oscillating { low, high } => {
                 write!(f, "oscillating (steps {low:.1e} to {high:.1e} without a trend)")
             }
-            StepTrend::Steady { size } => write!(f, "steady (steps ~{size:.1e}, neither shrinking nor swinging)"),
+            StepTrend::Steady { size } => {
+                write!(f, "steady (steps ~{size:.1e}, neither shrinking nor swinging)")
+            }
             StepTrend::Growing { rho } => write!(f, "growing ({rho:.4} per iteration)"),
         }
     }

@@ -520,7 +520,9 @@ mod tests {
         assert_eq!(s.shape_reasons().count(), 1, "the fold, not the cap");
         let swinging = Unfinished { trend: Some(StepTrend::Oscillating { low: 1e-4, high: 2e-3 }), ..capped };
         assert!(
-            swinging.to_string().ends_with("(tolerance 1e-5), oscillating (steps 1.0e-4 to 2.0e-3 without a trend)"),
+            swinging
+                .to_string()
+                .ends_with("(tolerance 1e-5), oscillating (steps 1.0e-4 to 2.0e-3 without a trend)"),
             "{swinging}"
         );
         let parsed: Status = Status::judge(&[swinging], vec![]).to_string().parse().unwrap();

@@ -232,7 +232,11 @@ pub struct DistanceBound {
 impl DistanceBound {
     /// A rule that is met once the bound falls below `tolerance` (same units as the steps).
     pub fn new(tolerance: f64) -> Self {
-        Self { tolerance, steps: Vec::with_capacity(CONTRACTION_WINDOW + 2), floor: std::cell::Cell::new(0.0) }
+        Self {
+            tolerance,
+            steps: Vec::with_capacity(CONTRACTION_WINDOW + 2),
+            floor: std::cell::Cell::new(0.0),
+        }
     }
 
     /// The bound after a further step `step`, without recording it.

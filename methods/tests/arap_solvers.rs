@@ -160,5 +160,8 @@ fn the_gradient_keeps_lbfgs_going_across_a_plateau_of_its_steps() {
     let distance = max_displacement(&answer, &fixed) / diagonal;
     eprintln!("plane: {} iterations, {distance:.2e} diagonals from the fixed point", summary.iterations);
     assert!(summary.converged, "{summary:?}");
-    assert!(distance < 3e-5, "the answer at 1e-5 is {distance:e} diagonals from the fixed point: {summary:?}");
+    assert!(
+        distance < 3e-5,
+        "the answer at 1e-5 is {distance:e} diagonals from the fixed point: {summary:?}"
+    );
 }
