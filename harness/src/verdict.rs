@@ -175,8 +175,8 @@ impl VerdictRules {
     }
 }
 
-/// Why a case's iteration did not finish: one edit step that stopped before its step fell below
-/// the method's tolerance.
+/// Why a case's iteration did not finish: one edit step that stopped before its estimated distance
+/// to the fixed point fell below the method's tolerance.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Unfinished {
     /// 1-based edit step, and how many the scenario has.

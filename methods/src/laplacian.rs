@@ -23,8 +23,9 @@
 //!   factors numerically.
 //! - Acceleration (`acceleration`, default `anderson`): eq 3 is the fixed-point map
 //!   `X <- G(X) = (A^T A)^{-1} A^T b(X)`; Anderson acceleration (depth `anderson_depth`,
-//!   [`crate::linalg::anderson`]) extrapolates from its last steps. The stopping test is the plain
-//!   step `|G(X) - X|` either way, so the fixed point is the same (tested); `"none"` is the paper's
+//!   [`crate::linalg::anderson`]) extrapolates from its last steps. The stopping rule reads the plain
+//!   steps `|G(X) - X|` either way (their distance bound, [`DistanceBound`]), so the fixed point is
+//!   the same (tested); `"none"` is the paper's
 //!   iteration. Why: the plain iteration contracts slowly where a long limb has to turn (the survey
 //!   cactus took 916 plain iterations, 169 accelerated). The armadillo does not settle either way: its
 //!   free left arm keeps swinging (configs/methods.toml).

@@ -39,8 +39,8 @@
 //! Zhang, Geng, Qin & Liu 2018; depth `anderson_depth`) extrapolates from the last
 //! steps. Their safeguard keeps the energy monotone: when the accelerated iterate's energy (with its
 //! own local-step rotations) exceeds the previous iterate's, it is replaced by the plain image
-//! `G(X_prev)` and the history is dropped. Convergence is judged on the plain step `|G(X) - X|`
-//! (the same quantity the plain iteration reports), and a converged solve returns `G(X)`, the global
+//! `G(X_prev)` and the history is dropped. Convergence is judged on the plain steps `|G(X) - X|`
+//! (their distance bound, [`DistanceBound`]; the quantity the plain iteration reports), and a converged solve returns `G(X)`, the global
 //! solution for the last rotations. The fixed points are those of the plain iteration.
 //!
 //! Phases: `precompute` builds the weights and the symbolic factorization of `-L`'s pattern;
