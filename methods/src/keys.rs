@@ -58,3 +58,16 @@ pub mod statistic {
     pub const OUTER_ITERATIONS: &str = "outer_iterations";
     pub const NORMAL_ITERATIONS: &str = "normal_iterations";
 }
+
+/// The registered method names, the one place they are spelled (re-exported by
+/// [`crate::registry`], whose table registers them; the harness's reports and tables use them).
+pub mod method_name {
+    pub const LAPLACIAN: &str = "laplacian";
+    pub const ARAP: &str = "arap";
+    pub const HIRM: &str = "hirm";
+    pub const SPECTRAL_MHB: &str = "spectral_mhb";
+    pub const SCALE_AWARE: &str = "scale_aware";
+    pub const SCALE_AWARE_ORA: &str = "scale_aware_ora";
+    pub const ISOLINES: &str = "isolines";
+    pub const ISOLINES_T1: &str = "isolines_t1";
+}

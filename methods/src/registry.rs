@@ -11,16 +11,9 @@ use crate::method::DeformationMethod;
 use crate::scale_aware::ScaleAware;
 use crate::spectral_mhb::SpectralMhb;
 
-// The registered method names, the one place they are spelled (the entries below, the harness's
-// reports and tables use these).
-pub const LAPLACIAN: &str = "laplacian";
-pub const ARAP: &str = "arap";
-pub const HIRM: &str = "hirm";
-pub const SPECTRAL_MHB: &str = "spectral_mhb";
-pub const SCALE_AWARE: &str = "scale_aware";
-pub const SCALE_AWARE_ORA: &str = "scale_aware_ora";
-pub const ISOLINES: &str = "isolines";
-pub const ISOLINES_T1: &str = "isolines_t1";
+// The registered method names live in `crate::keys::method_name` (a method module may name
+// another, as `scale_aware_ora` names the `scale_aware` it reuses, without importing this table).
+pub use crate::keys::method_name::*;
 
 /// One registered method.
 pub struct MethodEntry {

@@ -374,7 +374,7 @@ impl ScaleAware {
         self.current.clone_from(&taken.positions);
         self.frames.clone_from(&taken.frames);
         self.timings = taken.timings;
-        self.reused = Some(ReusedSolve { from: crate::registry::SCALE_AWARE, seconds: taken.seconds });
+        self.reused = Some(ReusedSolve { from: crate::keys::method_name::SCALE_AWARE, seconds: taken.seconds });
         let last = taken.reports.len().saturating_sub(1);
         for (i, (report, iterate)) in taken.reports.iter().enumerate() {
             let iterate = match iterate {
