@@ -14,7 +14,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (p, t) = (mesh.positions(), mesh.triangles());
     let n = mesh.n_vertices();
     let measures = ScaleInvariantMeasures::new(p, t, &topology);
-    let pyramids = NormalPyramids::new(p, t, &measures.normals);
+    let pyramids = NormalPyramids::new(p, t, &measures.normals, Default::default());
     let mut normals = measures.normals.clone();
     let equations = ScaleAwareEquations::new(n, t, measures);
     // The first 10 vertices constrained: enough to make the system definite.

@@ -57,6 +57,9 @@ pub mod statistic {
     /// scale_aware's outer iterations and Gauss-map (normal) iterations.
     pub const OUTER_ITERATIONS: &str = "outer_iterations";
     pub const NORMAL_ITERATIONS: &str = "normal_iterations";
+    /// scale_aware's step two: numeric factorizations, and lagged steps with a held one.
+    pub const REFACTORIZATIONS: &str = "refactorizations";
+    pub const LAGGED_STEPS: &str = "lagged_steps";
 }
 
 /// The registered method names, the one place they are spelled (re-exported by

@@ -129,7 +129,7 @@ fn constraints_from_a_scaled_and_rotated_copy_reproduce_the_copy() {
 fn step_one_keeps_unit_normals_and_rest_normals() {
     let (mesh, _) = cylinder();
     let rest_normals = face_normals(mesh.positions(), mesh.triangles());
-    let pyramids = NormalPyramids::new(mesh.positions(), mesh.triangles(), &rest_normals);
+    let pyramids = NormalPyramids::new(mesh.positions(), mesh.triangles(), &rest_normals, Default::default());
     let n = mesh.n_vertices();
     let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     let (mut rotations, mut frames) = (vec![identity; n], vec![identity; n]);
@@ -250,6 +250,63 @@ fn ora_takes_an_identical_scale_aware_solve_and_gives_the_same_result() {
     // Another constraint weight: a solve of other inputs is not taken.
     let (other, _, _) = run(ScaleAwareParams { constraint_weight: 50.0, ..ora }, "scale_aware_ora");
     assert_eq!(other.reused_solve(), None, "another lambda is another solve");
+}
+
+/// The solve of a bend of the procedural cylinder with `params`, to a tight tolerance: the result
+/// and the step-two statistics (refactorizations, lagged steps).
+fn tight_bend(params: ScaleAwareParams) -> (Vec<[f64; 3]>, f64, f64, f64) {
+    let (mesh, handles) = cylinder();
+    let bent: Vec<[f64; 3]> =
+        mesh.positions().iter().map(|p| [p[0] + 0.3 * p[2] * p[2], p[1], p[2]]).collect();
+    let params = ScaleAwareParams { tolerance: 1e-10, max_iterations: 3000, ..params };
+    let mut m = ScaleAware::new("scale_aware", params).unwrap();
+    m.precompute(&mesh).unwrap();
+    m.bind_handles(&handles).unwrap();
+    let summary = m.solve(&targets_from(&handles, &bent), &mut NoObserver).unwrap();
+    assert!(summary.converged, "{summary:?}");
+    let statistic = |key: &str| m.model_statistics().iter().find(|(k, _)| k == key).unwrap().1;
+    let (refactorizations, lagged) = (
+        statistic(methods::keys::statistic::REFACTORIZATIONS),
+        statistic(methods::keys::statistic::LAGGED_STEPS),
+    );
+    (m.positions(), mesh.bbox_diagonal(), refactorizations, lagged)
+}
+
+#[test]
+fn lagged_factorization_meets_the_refactor_every_iteration_fixed_point() {
+    // The plain iteration (no Anderson: one path per map), step two exact every time or lagged.
+    let plain = ScaleAwareParams { anderson_depth: 0, ..Default::default() };
+    let (exact, diagonal, exact_factors, exact_lagged) =
+        tight_bend(ScaleAwareParams { refactor_turn: 0.0, ..plain.clone() });
+    let (lagged, _, lagged_factors, lagged_steps) =
+        tight_bend(ScaleAwareParams { refactor_turn: 0.1, ..plain });
+    assert_eq!(exact_lagged, 0.0, "refactor_turn = 0 refactors every time");
+    assert!(exact_factors > 10.0);
+    assert!(
+        lagged_steps > 2.0 * lagged_factors,
+        "{lagged_factors} factorizations, {lagged_steps} lagged steps"
+    );
+    let d = max_distance(&exact, &lagged) / diagonal;
+    assert!(d < 1e-7, "the lagged path ends {d:.2e} of the diagonal from the exact path's fixed point");
+}
+
+#[test]
+fn an_accelerated_solve_stops_within_its_tolerance_of_the_limit_of_its_path() {
+    // The same solve stopped by the default tolerance and run on to 1e-10: the first must be within
+    // its 1e-4 of the diagonal of the second (the stopping rule takes the plain map's secant
+    // contraction; from the accelerated steps alone it stopped 1.4e-3 away here).
+    let params = ScaleAwareParams { refactor_turn: 0.0, ..Default::default() };
+    let (limit, diagonal, _, _) = tight_bend(params.clone());
+    let (mesh, handles) = cylinder();
+    let bent: Vec<[f64; 3]> =
+        mesh.positions().iter().map(|p| [p[0] + 0.3 * p[2] * p[2], p[1], p[2]]).collect();
+    let mut m = ScaleAware::new("scale_aware", params).unwrap();
+    m.precompute(&mesh).unwrap();
+    m.bind_handles(&handles).unwrap();
+    let summary = m.solve(&targets_from(&handles, &bent), &mut NoObserver).unwrap();
+    assert!(summary.converged);
+    let d = max_distance(&m.positions(), &limit) / diagonal;
+    assert!(d < 1e-4, "stopped {d:.2e} of the diagonal from the limit ({summary:?})");
 }
 
 #[test]

@@ -7,11 +7,16 @@
 //! normals, `N'_f = sum_{v in f} w_vf R_v N_f / sum_{v in f} w_vf`, normalized to the sphere.
 //!
 //! Decisions the paper leaves open:
-//! - Weights. The paper asks for "cotangent weights" on spokes that are face normals, which have no
-//!   edge of their own. We weight the spoke of face `f` at `v` by the Voronoi area of corner
+//! - Weights ([`SpokeWeights`], `normal_weights`). The paper asks for "cotangent weights" (eq 7)
+//!   on spokes that are face normals, which have no edge of their own, and eq 11 prints equal
+//!   thirds. By default we weight the spoke of face `f` at `v` by the Voronoi area of corner
 //!   `(v, f)` (Meyer et al. 2003: `(|e_1|^2 cot + |e_2|^2 cot) / 8`, the obtuse rule on obtuse
 //!   triangles) — the cotangent formula for the surface area the normal stands for, so the energy
-//!   is consistent on non-uniform meshes. Eq 11 (equal thirds) is the uniform special case.
+//!   is consistent on non-uniform meshes. `cotan` reads eq 7 literally: the spoke's share of the
+//!   cotangent weights of the two edges of `f` at `v`, `(cot beta + cot gamma) / 2` with `beta`,
+//!   `gamma` the angles of `f` at its other corners (clamped at 0: an obtuse corner would make it
+//!   negative, and a negative weight turns the Procrustes fit away from the spoke); `uniform` is
+//!   eq 11's 1/3 (weight 1 per spoke).
 //! - Eq 8 prints `S_v = sum w e e^T`; the ARAP cross-covariance it cites is `sum w e' e^T`.
 //! - The inner loop starts from the normals of the current shape and stops when no normal moves by
 //!   more than `tolerance` (radians, chord length) or after `max_iterations`.
@@ -23,6 +28,45 @@ use meshes::vector::{norm, scale, sub};
 
 use crate::operators::{corner_areas, MassKind};
 use crate::rotation_fit::{closest_rotation_warm, Mat3};
+
+/// The weight of the spoke of face `f` in the pyramid of its corner `v` (module documentation).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpokeWeights {
+    /// The Voronoi area of the corner (Meyer et al. 2003).
+    #[default]
+    Voronoi,
+    /// Eq 7 read literally: half the cotangents of `f`'s angles at its other two corners, >= 0.
+    Cotan,
+    /// Eq 11: every spoke alike.
+    Uniform,
+}
+
+/// `#F x 3` spoke weights of every corner of `triangles` (on `positions`).
+fn spoke_weights(positions: &[[f64; 3]], triangles: &[[u32; 3]], kind: SpokeWeights) -> Vec<[f64; 3]> {
+    match kind {
+        SpokeWeights::Voronoi => corner_areas(positions, triangles, MassKind::Voronoi),
+        SpokeWeights::Uniform => vec![[1.0; 3]; triangles.len()],
+        SpokeWeights::Cotan => triangles
+            .iter()
+            .map(|t| {
+                let p = t.map(|v| positions[v as usize]);
+                let cot = |k: usize| {
+                    let (a, b) = (sub(p[(k + 1) % 3], p[k]), sub(p[(k + 2) % 3], p[k]));
+                    let c = meshes::vector::cross(a, b);
+                    let s = norm(c);
+                    if s > 0.0 {
+                        meshes::vector::dot(a, b) / s
+                    } else {
+                        0.0
+                    }
+                };
+                let cots = [cot(0), cot(1), cot(2)];
+                std::array::from_fn(|k| (0.5 * (cots[(k + 1) % 3] + cots[(k + 2) % 3])).max(0.0))
+            })
+            .collect(),
+    }
+}
 
 /// Below this many faces the phases run on one thread (rayon's split costs more than it saves).
 const PARALLEL_MIN_FACES: usize = 4_000;
@@ -51,9 +95,14 @@ pub struct NormalUpdate {
 
 impl NormalPyramids {
     /// Pyramids of the rest mesh (`#V x 3` `positions`, `#F x 3` `triangles`, `#F` unit
-    /// `rest_normals`).
-    pub fn new(positions: &[[f64; 3]], triangles: &[[u32; 3]], rest_normals: &[[f64; 3]]) -> Self {
-        let corner_weights = corner_areas(positions, triangles, MassKind::Voronoi);
+    /// `rest_normals`) with spoke weights of kind `weights`.
+    pub fn new(
+        positions: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+        rest_normals: &[[f64; 3]],
+        weights: SpokeWeights,
+    ) -> Self {
+        let corner_weights = spoke_weights(positions, triangles, weights);
         let mut offsets = vec![0usize; positions.len() + 1];
         for t in triangles {
             for &v in t {

@@ -3,12 +3,25 @@
 //! normals: the symbolic factorization is computed once per mesh, the numeric one every outer
 //! iteration, then one back-substitution.
 //!
+//! Lagged factorization ([`VertexRecovery::step`]). The paper's "factorized once" cannot hold in 3D:
+//! `G` holds `l R(N, theta)`, so `G^T G` changes with the normals. But near the fixed point the
+//! normals barely move between outer iterations, and the factor of an earlier `A_j = A(N_j)` is a
+//! good approximate inverse of the current `A = A(N)`. A lagged step replaces the exact
+//! `x' = A^{-1} b` by one correction `x' = x + A_j^{-1} (b - A x)`: its fixed points are those of
+//! the exact step (`x' = x` iff `A x = b`), so Algorithm 1's fixed points do not change, only the
+//! path to them. Safeguards, each sending the step to a fresh factorization of `A` and the exact
+//! step: no factor yet (or the handles changed), some normal turned by more than `max_turn` since
+//! the factor, or the lagged step came out longer than the previous outer iteration's step (the
+//! correction stopped contracting).
+//!
 //! (Reusing the last factorization as a conjugate-gradient preconditioner instead was measured and
 //! dropped: on the survey cactus and plane it needed 5–6 back-substitutions per outer iteration,
-//! which cost as much as refactoring.)
+//! which cost as much as refactoring. One lagged correction per outer iteration is cheaper: the
+//! outer iteration is itself the outer loop such an inner solve would serve.)
 
-use faer::sparse::SparseColMat;
-use faer::Mat;
+use faer::sparse::{SparseColMat, SparseColMatRef};
+use faer::{Mat, MatRef};
+use rayon::prelude::*;
 
 use super::scale_aware_equations::ScaleAwareEquations;
 use crate::linalg::sparse_cholesky::{SolverError, SparseCholesky};
@@ -19,19 +32,107 @@ pub struct RecoveryTimings {
     pub assembly_s: f64,
     pub refactorization_s: f64,
     pub back_substitution_s: f64,
+    /// Steps taken with a fresh factorization, and with a held one ([`VertexRecovery::step`]).
+    pub refactorizations: usize,
+    pub lagged_steps: usize,
 }
 
-/// The step-two system with its symbolic factorization.
+/// The step-two system with its symbolic factorization and, for lagged steps, the last numeric one.
 pub struct VertexRecovery {
     matrix: SparseColMat<usize, f64>,
     cholesky: SparseCholesky,
+    /// `#F x 3` normals of the numeric factorization held by `cholesky`; empty when there is none.
+    factored_normals: Vec<[f64; 3]>,
+    /// `3 #V` storage of `b - A x`.
+    residual: Vec<f64>,
+}
+
+/// How a step of [`VertexRecovery::step`] was taken.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StepKind {
+    /// With the held factorization of an earlier matrix: one correction.
+    Lagged,
+    /// With a fresh factorization of the current matrix: the exact solution.
+    Refactored,
 }
 
 impl VertexRecovery {
     /// Symbolic analysis of the pattern of `equations`' normal matrix.
     pub fn new(equations: &ScaleAwareEquations) -> Result<Self, SolverError> {
         let matrix = equations.normal_matrix_pattern();
-        Ok(Self { cholesky: SparseCholesky::analyze(matrix.as_ref())?, matrix })
+        let n = matrix.nrows();
+        Ok(Self {
+            cholesky: SparseCholesky::analyze(matrix.as_ref())?,
+            matrix,
+            factored_normals: Vec::new(),
+            residual: vec![0.0; n],
+        })
+    }
+
+    /// Forget the held factorization (the constraint diagonal changed: a new handle set).
+    pub fn invalidate(&mut self) {
+        self.factored_normals.clear();
+    }
+
+    /// Step two, lagged when it may be (module documentation): into `next` (`3#V x 1`, interleaved)
+    /// the vertices for `#F x 3` `normals` from `3#V` interleaved `current` and `rhs` (`3#V x 1`,
+    /// `lambda C V*`). A lagged step is taken when a factorization is held, no normal turned by
+    /// more than `max_turn` (chord length) since it, and the step's largest vertex move is at most
+    /// `previous_step` (the last outer iteration's, same units as `current`); otherwise the matrix
+    /// is refactored and the step is exact. `max_turn = 0` refactors every time.
+    #[allow(clippy::too_many_arguments)]
+    pub fn step(
+        &mut self,
+        equations: &ScaleAwareEquations,
+        normals: &[[f64; 3]],
+        constraint_diagonal: &[f64],
+        rhs: MatRef<'_, f64>,
+        current: &[f64],
+        max_turn: f64,
+        previous_step: f64,
+        next: &mut Mat<f64>,
+        timings: &mut RecoveryTimings,
+    ) -> Result<StepKind, SolverError> {
+        let t = std::time::Instant::now();
+        equations.assemble_normal_matrix(normals, constraint_diagonal, self.matrix.val_mut());
+        timings.assembly_s += t.elapsed().as_secs_f64();
+
+        if max_turn > 0.0 && largest_turn(&self.factored_normals, normals) <= max_turn {
+            let t = std::time::Instant::now();
+            symmetric_residual(self.matrix.as_ref(), current, rhs, &mut self.residual);
+            for (i, r) in self.residual.iter().enumerate() {
+                next[(i, 0)] = *r;
+            }
+            self.cholesky.solve_in_place(next.as_mut());
+            let mut step2: f64 = 0.0;
+            for v in 0..current.len() / 3 {
+                let d = [next[(3 * v, 0)], next[(3 * v + 1, 0)], next[(3 * v + 2, 0)]];
+                step2 = step2.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            }
+            for (i, x) in current.iter().enumerate() {
+                next[(i, 0)] += x;
+            }
+            timings.back_substitution_s += t.elapsed().as_secs_f64();
+            if step2.sqrt() <= previous_step {
+                timings.lagged_steps += 1;
+                return Ok(StepKind::Lagged);
+            }
+        }
+
+        let t = std::time::Instant::now();
+        self.cholesky.factorize(self.matrix.as_ref())?;
+        self.factored_normals.clear();
+        self.factored_normals.extend_from_slice(normals);
+        timings.refactorization_s += t.elapsed().as_secs_f64();
+
+        let t = std::time::Instant::now();
+        for i in 0..current.len() {
+            next[(i, 0)] = rhs[(i, 0)];
+        }
+        self.cholesky.solve_in_place(next.as_mut());
+        timings.back_substitution_s += t.elapsed().as_secs_f64();
+        timings.refactorizations += 1;
+        Ok(StepKind::Refactored)
     }
 
     /// Solve eq 12 for `#F x 3` `normals` and the `3 #V` `constraint_diagonal`; `rhs_solution`
@@ -50,11 +151,55 @@ impl VertexRecovery {
 
         let t = std::time::Instant::now();
         self.cholesky.factorize(self.matrix.as_ref())?;
+        self.factored_normals.clear();
+        self.factored_normals.extend_from_slice(normals);
         timings.refactorization_s += t.elapsed().as_secs_f64();
 
         let t = std::time::Instant::now();
         self.cholesky.solve_in_place(rhs_solution.as_mut());
         timings.back_substitution_s += t.elapsed().as_secs_f64();
+        timings.refactorizations += 1;
         Ok(())
     }
 }
+
+/// Largest chord `|a_f - b_f|` between the unit normals of `held` and `normals` (`#F x 3` each);
+/// infinite when `held` is empty (no factorization).
+fn largest_turn(held: &[[f64; 3]], normals: &[[f64; 3]]) -> f64 {
+    if held.len() != normals.len() || held.is_empty() {
+        return f64::INFINITY;
+    }
+    let mut d2: f64 = 0.0;
+    for (a, b) in held.iter().zip(normals) {
+        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        d2 = d2.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    }
+    d2.sqrt()
+}
+
+/// `residual = rhs - A x` for a symmetric `A` stored with both triangles (`n x n`), `x` and
+/// `residual` of length `n`, `rhs` `n x 1`. Column `j` of `A` is its row `j`, so each entry is one
+/// column's dot product: no scatter, and the sum order is fixed.
+fn symmetric_residual(
+    a: SparseColMatRef<'_, usize, f64>,
+    x: &[f64],
+    rhs: MatRef<'_, f64>,
+    residual: &mut [f64],
+) {
+    let (col_ptr, row_idx, values) = (a.col_ptr(), a.row_idx(), a.val());
+    let row = |j: usize| -> f64 {
+        let mut s = 0.0;
+        for k in col_ptr[j]..col_ptr[j + 1] {
+            s += values[k] * x[row_idx[k]];
+        }
+        rhs[(j, 0)] - s
+    };
+    if residual.len() >= PARALLEL_MIN_ROWS {
+        residual.par_iter_mut().enumerate().for_each(|(j, r)| *r = row(j));
+    } else {
+        residual.iter_mut().enumerate().for_each(|(j, r)| *r = row(j));
+    }
+}
+
+/// Below this many rows the residual is computed on one thread.
+const PARALLEL_MIN_ROWS: usize = 12_000;
