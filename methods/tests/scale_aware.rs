@@ -9,7 +9,7 @@ use meshes::shapes::{generate, ShapeKind};
 use meshes::vector::{norm, sub};
 use meshes::{Topology, TriMesh, VertexStatus};
 use methods::scale_aware::{
-    rescaled_triangles, AndersonAcceleration, NormalPyramids, ScaleAware, ScaleAwareEquations,
+    rescaled_triangles, AndersonAcceleration, LaterStart, NormalPyramids, ScaleAware, ScaleAwareEquations,
     ScaleAwareParams, ScaleInvariantMeasures,
 };
 use methods::{DeformationMethod, HandleRegion, HandleSet, HandleTargets, MethodError, NoObserver};
@@ -307,6 +307,28 @@ fn an_accelerated_solve_stops_within_its_tolerance_of_the_limit_of_its_path() {
     assert!(summary.converged);
     let d = max_distance(&m.positions(), &limit) / diagonal;
     assert!(d < 1e-4, "stopped {d:.2e} of the diagonal from the limit ({summary:?})");
+}
+
+#[test]
+fn a_later_solve_starts_from_the_last_result_or_from_its_laplacian_editing() {
+    // A second solve of the same targets: from the last result (a warm start) iteration 0 does
+    // not move the shape; from Laplacian editing of it (the default) it does.
+    let first_step = |later_start| {
+        let (mesh, handles) = cylinder();
+        let bent: Vec<[f64; 3]> =
+            mesh.positions().iter().map(|p| [p[0] + 0.3 * p[2] * p[2], p[1], p[2]]).collect();
+        let params = ScaleAwareParams { later_start, ..Default::default() };
+        let mut m = ScaleAware::new("scale_aware", params).unwrap();
+        m.precompute(&mesh).unwrap();
+        m.bind_handles(&handles).unwrap();
+        let targets = targets_from(&handles, &bent);
+        m.solve(&targets, &mut NoObserver).unwrap();
+        let mut reports = Reports(Vec::new());
+        m.solve(&targets, &mut reports).unwrap();
+        reports.0[0].0.step
+    };
+    assert_eq!(first_step(LaterStart::PreviousResult), 0.0);
+    assert!(first_step(LaterStart::Laplacian) > 1e-4);
 }
 
 #[test]
