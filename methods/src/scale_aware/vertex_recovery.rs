@@ -112,19 +112,10 @@ impl VertexRecovery {
             }
         }
 
-        let t = std::time::Instant::now();
-        self.cholesky.factorize(self.matrix.as_ref())?;
-        self.factored_normals.clear();
-        self.factored_normals.extend_from_slice(normals);
-        timings.refactorization_s += t.elapsed().as_secs_f64();
-
-        let t = std::time::Instant::now();
         for i in 0..current.len() {
             next[(i, 0)] = rhs[(i, 0)];
         }
-        self.cholesky.solve_in_place(next.as_mut());
-        timings.back_substitution_s += t.elapsed().as_secs_f64();
-        timings.refactorizations += 1;
+        self.refactor_and_solve(normals, next, timings)?;
         Ok(StepKind::Refactored)
     }
 
@@ -184,6 +175,17 @@ impl VertexRecovery {
         equations.assemble_normal_matrix(normals, constraint_diagonal, self.matrix.val_mut());
         timings.assembly_s += t.elapsed().as_secs_f64();
 
+        self.refactor_and_solve(normals, rhs_solution, timings)
+    }
+
+    /// Factor the assembled matrix (held for lagged steps, with the `#F x 3` `normals` it was
+    /// built from) and solve it in place for `rhs_solution` (`3#V x 1`).
+    fn refactor_and_solve(
+        &mut self,
+        normals: &[[f64; 3]],
+        rhs_solution: &mut Mat<f64>,
+        timings: &mut RecoveryTimings,
+    ) -> Result<(), SolverError> {
         let t = std::time::Instant::now();
         self.cholesky.factorize(self.matrix.as_ref())?;
         self.factored_normals.clear();
