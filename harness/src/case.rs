@@ -232,7 +232,7 @@ pub fn run_case(
                     trend: tolerance.and_then(|t| {
                         let steps: Vec<f64> =
                             recorder.trace[first_iteration..].iter().map(|r| r.step).collect();
-                        StepTrend::of(&steps, t)
+                        StepTrend::of(&steps, t).map(|trend| trend.with_distance(summary.distance, t))
                     }),
                 });
             }

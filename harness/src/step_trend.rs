@@ -80,6 +80,20 @@ impl StepTrend {
             Some(StepTrend::Steady { size: mean_y.exp() })
         }
     }
+
+    /// The trend with the iteration's own estimate of its distance to the fixed point taken into
+    /// account: a contracting trend needs at least the iterations that bring `distance` below
+    /// `tolerance` at its rate (a method whose bound sees more than its steps, as `scale_aware`'s
+    /// secant contraction, would otherwise read "~0 more iterations" beside a distance far above
+    /// the tolerance).
+    pub fn with_distance(self, distance: f64, tolerance: f64) -> StepTrend {
+        match self {
+            StepTrend::Contracting { rho, more } if distance.is_finite() && distance > tolerance => {
+                StepTrend::Contracting { rho, more: more.max((tolerance / distance).ln() / rho.ln()) }
+            }
+            trend => trend,
+        }
+    }
 }
 
 impl fmt::Display for StepTrend {
@@ -115,6 +129,15 @@ mod tests {
         let last = steps[499];
         let expected = ((1e-5 * (1.0 - rho) / rho) / last).ln() / rho.ln();
         assert!((more - expected).abs() < 1e-6, "{more} vs {expected}");
+    }
+
+    #[test]
+    fn the_reported_distance_lengthens_a_contracting_trend() {
+        let trend = StepTrend::Contracting { rho: 0.9, more: 0.0 };
+        let StepTrend::Contracting { more, .. } = trend.with_distance(1e-3, 1e-4) else { unreachable!() };
+        assert!((more - (0.1f64).ln() / (0.9f64).ln()).abs() < 1e-12, "{more}");
+        assert_eq!(trend.with_distance(1e-5, 1e-4), trend);
+        assert_eq!(trend.with_distance(f64::INFINITY, 1e-4), trend);
     }
 
     #[test]
