@@ -38,7 +38,8 @@
 //!   guess only. Algorithm 1 itself has no cotangent Laplacian: step two's `G(Theta, N)` is built
 //!   from corner angles, and step one's normal-pyramid weights are face areas ([`gauss_map`]).
 //! - Every solve starts from the Laplacian initialization of the current shape, so a second edit
-//!   step is handled like the first.
+//!   step is handled like the first (`later_start = "previous_result"` starts a later one from the
+//!   last result instead; measured no faster, docs/results.md issue 52).
 //! - Acceleration. Algorithm 1 converges linearly and slowly: on the survey cactus the largest step
 //!   is still 1e-3 of the diagonal after 50 plain outer iterations (E_phi 0.49 deg, 0.43 after
 //!   300). The outer iteration is therefore Anderson-accelerated ([`crate::linalg::anderson`],
@@ -394,12 +395,12 @@ impl ScaleAware {
         self.secants.iter().copied().fold(0.0, f64::max)
     }
 
-    /// Replace `self.solution` (`T(x)`) by the Anderson-accelerated next iterate.
+    /// Replace `self.solution` (`T(x)`) by the Anderson-accelerated next iterate; `self.flat_x`
+    /// holds `x` (interleaved), as step two left it.
     fn accelerate(&mut self, anderson: &mut AndersonAcceleration) {
         let n = self.current.len();
         for i in 0..n {
             for c in 0..3 {
-                self.flat_x[3 * i + c] = self.current[i][c];
                 self.flat_g[3 * i + c] = self.solution[(i, c)];
             }
         }

@@ -29,6 +29,7 @@ use rayon::prelude::*;
 
 use super::scale_aware_equations::ScaleAwareEquations;
 use crate::linalg::sparse_cholesky::{SolverError, SparseCholesky};
+use crate::method::max_displacement;
 
 /// Time spent in step two during one `solve`, in seconds.
 #[derive(Clone, Copy, Debug, Default)]
@@ -51,15 +52,6 @@ pub struct VertexRecovery {
     residual: Vec<f64>,
     /// `3 #V` storage of a lagged step's iterate.
     lagged: Vec<f64>,
-}
-
-/// How a step of [`VertexRecovery::step`] was taken.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum StepKind {
-    /// With the held factorization of an earlier matrix: one correction.
-    Lagged,
-    /// With a fresh factorization of the current matrix: the exact solution.
-    Refactored,
 }
 
 impl VertexRecovery {
@@ -97,7 +89,7 @@ impl VertexRecovery {
         max_turn: f64,
         next: &mut Mat<f64>,
         timings: &mut RecoveryTimings,
-    ) -> Result<StepKind, SolverError> {
+    ) -> Result<(), SolverError> {
         let t = std::time::Instant::now();
         equations.assemble_normal_matrix(normals, constraint_diagonal, self.matrix.val_mut());
         timings.assembly_s += t.elapsed().as_secs_f64();
@@ -108,15 +100,14 @@ impl VertexRecovery {
             timings.back_substitution_s += t.elapsed().as_secs_f64();
             if accepted {
                 timings.lagged_steps += 1;
-                return Ok(StepKind::Lagged);
+                return Ok(());
             }
         }
 
         for i in 0..current.len() {
             next[(i, 0)] = rhs[(i, 0)];
         }
-        self.refactor_and_solve(normals, next, timings)?;
-        Ok(StepKind::Refactored)
+        self.refactor_and_solve(normals, next, timings)
     }
 
     /// The stationary iteration `y <- y + A_j^{-1} (b - A y)` from `y = current` with the held
@@ -206,12 +197,7 @@ fn largest_turn(held: &[[f64; 3]], normals: &[[f64; 3]]) -> f64 {
     if held.len() != normals.len() || held.is_empty() {
         return f64::INFINITY;
     }
-    let mut d2: f64 = 0.0;
-    for (a, b) in held.iter().zip(normals) {
-        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-        d2 = d2.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    }
-    d2.sqrt()
+    max_displacement(held, normals)
 }
 
 /// `residual = rhs - A x` for a symmetric `A` stored with both triangles (`n x n`), `x` and
