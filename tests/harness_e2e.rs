@@ -311,30 +311,10 @@ fn without_survey_data_the_procedural_look_alikes_run_and_are_labelled() {
     let page = std::fs::read_to_string(&index).unwrap();
     assert!(page.contains("Not checked"), "a procedural run is not compared with the survey baseline");
     let Some(chromium) = support::chromium() else { return };
-    let (loaded, total) = images_loaded_in_chromium(&chromium, &index);
+    let (loaded, total) = support::images_loaded_in_chromium(&chromium, &index);
     let expected = page.matches("<img ").count();
     assert!(expected >= 12, "index.html links {expected} images");
     assert_eq!((loaded, total), (expected, expected), "images loaded / present in index.html");
-}
-
-/// Open `page` in headless Chromium and read the count its script writes into `#image-check`:
-/// `(images loaded, images on the page)`.
-fn images_loaded_in_chromium(chromium: &Path, page: &Path) -> (usize, usize) {
-    let url = format!("file://{}", page.canonicalize().unwrap().display());
-    let (dom, stderr) = dump_dom(chromium, &url);
-    let check = dom
-        .split("<p id=\"image-check\"")
-        .nth(1)
-        .unwrap_or_else(|| panic!("no #image-check in the DOM; chromium said: {stderr}"));
-    let attribute = |name: &str| -> usize {
-        let value = check.split(&format!("{name}=\"")).nth(1).and_then(|v| v.split('"').next()).unwrap_or("");
-        value
-            .parse()
-            .unwrap_or_else(|_| panic!("#image-check {name} = {value:?} (the page script did not run)"))
-    };
-    let broken = check.split("data-broken=\"").nth(1).and_then(|v| v.split('"').next()).unwrap_or("");
-    assert!(broken.is_empty(), "images that did not load: {broken}");
-    (attribute("data-loaded"), attribute("data-total"))
 }
 
 /// How many methods configs/methods.toml gives a run: the registered ones and its variants and
@@ -342,30 +322,6 @@ fn images_loaded_in_chromium(chromium: &Path, page: &Path) -> (usize, usize) {
 fn configured_methods() -> usize {
     let path = support::workspace_root().join("configs/methods.toml");
     harness::config::MethodCatalog::load(&path).unwrap().methods().len()
-}
-
-/// The DOM of `url` after headless Chromium ran its scripts, and what Chromium said on stderr.
-fn dump_dom(chromium: &Path, url: &str) -> (String, String) {
-    let profile = tempfile::tempdir().unwrap();
-    let out = std::process::Command::new(chromium)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--allow-file-access-from-files",
-            "--virtual-time-budget=10000",
-        ])
-        .arg(format!("--user-data-dir={}", profile.path().display()))
-        .arg("--dump-dom")
-        .arg(url)
-        .output()
-        .expect("run chromium");
-    (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
 }
 
 /// The value of attribute `name` in the start tag `tag` (its text up to `>`).
@@ -396,7 +352,7 @@ fn the_page_ranks_sorts_and_filters_as_its_address_asks_in_chromium() {
     let rows = support::csv_rows(&reports.path().join("results.csv"));
     let index = reports.path().join("index.html").canonicalize().unwrap();
     let url = format!("file://{}?sort=e_theta_deg&desc=1&status=ok&rank=e_phi_deg", index.display());
-    let (dom, stderr) = dump_dom(&chromium, &url);
+    let (dom, stderr) = support::dump_dom(&chromium, &url);
     let table = dom.split("id=\"results-table\"").nth(1).unwrap_or_else(|| panic!("no table; {stderr}"));
     let body = table.split("<tbody>").nth(1).unwrap().split("</tbody>").next().unwrap();
     // (method, scenario, status, hidden) of each row, in the order the page shows them.
@@ -446,7 +402,7 @@ fn the_page_ranks_sorts_and_filters_as_its_address_asks_in_chromium() {
     // The 3D view of a case opened from the address, with another method on the left: it loads
     // the case's files and draws both canvases (pixels that are not background).
     let url = format!("file://{}?view=bar-arap&left=isolines&colour=angle", index.display());
-    let (dom, stderr) = dump_dom(&chromium, &url);
+    let (dom, stderr) = support::dump_dom(&chromium, &url);
     let viewer = dom.split("<div id=\"viewer\"").nth(1).unwrap_or_else(|| panic!("no viewer; {stderr}"));
     let tag = viewer.split('>').next().unwrap();
     assert!(!tag.contains(" hidden"), "the view is open: <div id=\"viewer\"{tag}>");

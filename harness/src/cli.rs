@@ -1,5 +1,5 @@
-//! The command line of the harness (`all`, `run`, `merge`, `check`, `baseline`, `compare`, `list`): the CLI edge, where
-//! errors become `anyhow` messages and exit codes. In the library so the end-to-end tests drive
+//! The command line of the harness (`all`, `run`, `merge`, `check`, `baseline`, `compare`, `list`,
+//! `history`): the CLI edge, where errors become `anyhow` messages and exit codes. In the library so the end-to-end tests drive
 //! exactly what the binary runs.
 
 use std::path::PathBuf;
@@ -19,6 +19,8 @@ use crate::staged_dir::StagedDir;
 use crate::suite::{self, SuiteOptions};
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
+
+mod history;
 
 #[derive(Parser)]
 #[command(
@@ -119,6 +121,12 @@ enum Command {
     },
     /// List the registered methods and the scenarios.
     List(Common),
+    /// Results across commits: record runs into the history store, run commits, show the
+    /// timelines with their steps, bisect a step (README, "Results across commits").
+    History {
+        #[command(subcommand)]
+        command: history::HistoryCommand,
+    },
     /// Run the whole method protocol once on a tiny built-in mesh (hello, precompute, two binds
     /// and solves, quit) and say what is wrong in plain words, with the times (docs/protocol.md);
     /// exit 0 when the method speaks the protocol. With --methods FILE for your own method.
@@ -441,6 +449,7 @@ where
                 Ok(ExitCode::from(EXIT_CASE_FAILED))
             }
         }
+        Command::History { command } => history::run(command),
         Command::List(common) => {
             let options = common.options(Vec::new(), Vec::new(), &command_line);
             println!("methods ({}):", options.configs_dir.join("methods.toml").display());

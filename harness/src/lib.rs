@@ -7,6 +7,7 @@
 //!
 //! ```text
 //! cli, method_check              the command line: parse, print, exit codes; `check-method`
+//! history/                       results across commits: store, timelines and steps, page, worktree runs
 //! pipeline                       publish a run: reports, plots, figures, gate, the page, in one directory
 //! report/                        the files people read, from records: tables, plots, pictures, page
 //! comparison                     two stored runs compared, case by case
@@ -25,6 +26,7 @@ pub mod cli;
 pub mod comparison;
 pub mod config;
 pub mod error;
+pub mod history;
 pub mod memory;
 pub mod method_check;
 pub mod metrics;

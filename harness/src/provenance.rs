@@ -120,7 +120,7 @@ impl Provenance {
 }
 
 impl Machine {
-    fn read() -> Self {
+    pub fn read() -> Self {
         let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
         let cpu_model = field(&cpuinfo, "model name", ':').unwrap_or_else(|| UNKNOWN.into());
         let meminfo = std::fs::read_to_string("/proc/meminfo").unwrap_or_default();

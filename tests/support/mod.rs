@@ -191,3 +191,47 @@ pub fn chromium() -> Option<std::path::PathBuf> {
     eprintln!("SKIPPED: no Chromium at {}", path.display());
     None
 }
+
+/// Open `page` in headless Chromium and read the count its script writes into `#image-check`:
+/// `(images loaded, images on the page)`.
+pub fn images_loaded_in_chromium(chromium: &Path, page: &Path) -> (usize, usize) {
+    let url = format!("file://{}", page.canonicalize().unwrap().display());
+    let (dom, stderr) = dump_dom(chromium, &url);
+    let check = dom
+        .split("<p id=\"image-check\"")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no #image-check in the DOM; chromium said: {stderr}"));
+    let attribute = |name: &str| -> usize {
+        let value = check.split(&format!("{name}=\"")).nth(1).and_then(|v| v.split('"').next()).unwrap_or("");
+        value
+            .parse()
+            .unwrap_or_else(|_| panic!("#image-check {name} = {value:?} (the page script did not run)"))
+    };
+    let broken = check.split("data-broken=\"").nth(1).and_then(|v| v.split('"').next()).unwrap_or("");
+    assert!(broken.is_empty(), "images that did not load: {broken}");
+    (attribute("data-loaded"), attribute("data-total"))
+}
+
+/// The DOM of `url` after headless Chromium ran its scripts, and what Chromium said on stderr.
+pub fn dump_dom(chromium: &Path, url: &str) -> (String, String) {
+    let profile = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--allow-file-access-from-files",
+            "--virtual-time-budget=10000",
+        ])
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .arg("--dump-dom")
+        .arg(url)
+        .output()
+        .expect("run chromium");
+    (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+}

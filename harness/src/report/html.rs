@@ -528,27 +528,32 @@ fn every_render(page: &mut String, context: &PageContext) {
     }
 }
 
+/// The image check the browser tests read: once the page has loaded, `#image-check` holds the
+/// images that loaded, all images, and the sources of those that did not.
+pub(crate) const IMAGE_CHECK: &str = concat!(
+    "<p id=\"image-check\" data-loaded=\"\" data-total=\"\"></p>\n",
+    "<script>\n",
+    "window.addEventListener('load', function () {\n",
+    "  var images = Array.prototype.slice.call(document.images);\n",
+    "  var loaded = images.filter(function (i) { return i.complete && i.naturalWidth > 0; });\n",
+    "  var broken = images.filter(function (i) { return !(i.complete && i.naturalWidth > 0); })\n",
+    "    .map(function (i) { return i.getAttribute('src'); });\n",
+    "  var p = document.getElementById('image-check');\n",
+    "  p.dataset.loaded = loaded.length; p.dataset.total = images.length;\n",
+    "  p.dataset.broken = broken.join(' ');\n",
+    "  p.textContent = 'Images loaded: ' + loaded.length + ' of ' + images.length + '.';\n",
+    "});\n",
+    "</script>\n"
+);
+
 /// The page's scripts, inlined, and the image check the browser test reads.
 fn scripts(page: &mut String, _: &PageContext) {
     page.push_str("<script>\n");
     page.push_str(include_str!("page.js"));
     page.push_str(include_str!("viewer.js"));
     page.push_str("</script>\n");
-    page.push_str(concat!(
-        "<p id=\"image-check\" data-loaded=\"\" data-total=\"\"></p>\n",
-        "<script>\n",
-        "window.addEventListener('load', function () {\n",
-        "  var images = Array.prototype.slice.call(document.images);\n",
-        "  var loaded = images.filter(function (i) { return i.complete && i.naturalWidth > 0; });\n",
-        "  var broken = images.filter(function (i) { return !(i.complete && i.naturalWidth > 0); })\n",
-        "    .map(function (i) { return i.getAttribute('src'); });\n",
-        "  var p = document.getElementById('image-check');\n",
-        "  p.dataset.loaded = loaded.length; p.dataset.total = images.length;\n",
-        "  p.dataset.broken = broken.join(' ');\n",
-        "  p.textContent = 'Images loaded: ' + loaded.length + ' of ' + images.length + '.';\n",
-        "});\n",
-        "</script>\n</body>\n</html>\n"
-    ));
+    page.push_str(IMAGE_CHECK);
+    page.push_str("</body>\n</html>\n");
 }
 
 /// "Quality against time": per test with sweep points its plot, budget table, fronts and points.

@@ -1,0 +1,266 @@
+//! `harness history`: record runs, fill the store from commits, show timelines, bisect a step.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, Subcommand};
+
+use crate::history::collect::{self, CollectOptions, FindTarget, Outcome};
+use crate::history::measures::Measure;
+use crate::history::store::{HistoryStore, Mixing, Recorded};
+use crate::history::{self, git, page, run_record, timeline};
+use crate::paths::SURVEY_DIR_ENV;
+
+#[derive(Subcommand)]
+pub(super) enum HistoryCommand {
+    /// Store runs (report directories or results.json files) with their provenance; a run already
+    /// stored adds nothing.
+    Record {
+        #[arg(required = true)]
+        reports: Vec<PathBuf>,
+        #[command(flatten)]
+        store: StoreArgs,
+        /// Keep a run of another data source or machine class (or other data files) on timelines of
+        /// its own instead of refusing it.
+        #[arg(long)]
+        allow_mixed: bool,
+        /// Record a run made from a tree that differed from its commit.
+        #[arg(long)]
+        allow_dirty: bool,
+    },
+    /// For each commit of the revisions (`A..B` is git's: after A up to B on the first-parent line;
+    /// a name is one commit): check it out in a worktree, build its harness, run the suite, record.
+    /// Resumable: commits recorded for the same arguments are skipped.
+    Run {
+        /// Revisions: `A..B` ranges and single commits.
+        #[arg(required = true)]
+        revisions: Vec<String>,
+        /// Run N commits evenly spread over the revisions (the first and last among them).
+        #[arg(long)]
+        steps: Option<usize>,
+        #[command(flatten)]
+        store: StoreArgs,
+        #[command(flatten)]
+        suite: SuiteArgs,
+    },
+    /// Write the history page: timelines per scenario × method (PNG), steps named with commits.
+    Show {
+        #[command(flatten)]
+        store: StoreArgs,
+        /// Where index.html, steps.md and plots/ go [default: history/page next to the store].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// The git checkout whose history orders the commits [default: this workspace's].
+        #[arg(long)]
+        repo: Option<PathBuf>,
+    },
+    /// Bisect the steps of MEASURE (e.g. iterations, peak_memory_mib, e_theta_deg) that lie between
+    /// two recorded commits that are not parent and child, running the commits between, until
+    /// each is named with the commit that made it.
+    Find {
+        measure: String,
+        #[arg(long)]
+        scenario: Option<String>,
+        #[arg(long)]
+        method: Option<String>,
+        #[command(flatten)]
+        store: StoreArgs,
+        #[command(flatten)]
+        suite: SuiteArgs,
+    },
+}
+
+#[derive(Args, Clone)]
+pub(super) struct StoreArgs {
+    /// The history store [env: DEFORMBENCH_HISTORY; default: history/history.sqlite in the
+    /// workspace].
+    #[arg(long)]
+    store: Option<PathBuf>,
+}
+
+impl StoreArgs {
+    fn path(&self) -> PathBuf {
+        self.store
+            .clone()
+            .or_else(|| super::path_from_env(history::STORE_ENV))
+            .unwrap_or_else(history::default_store)
+    }
+}
+
+#[derive(Args, Clone)]
+pub(super) struct SuiteArgs {
+    /// The survey's .off/.sel/.def files [env: DEFORM_SURVEY_DIR]; without it the procedural
+    /// look-alikes.
+    #[arg(long)]
+    survey_dir: Option<PathBuf>,
+    /// Scenario directory, relative to each commit's checkout (e.g. configs/real-meshes).
+    #[arg(long)]
+    scenarios: Option<PathBuf>,
+    /// Worker threads of every method.
+    #[arg(long, default_value_t = 2)]
+    threads: u32,
+    /// Rounds of each case: their spread is the band of the time timelines.
+    #[arg(long, default_value_t = 3)]
+    repeat: u32,
+    /// Worktree, build and logs [default: history/work next to the store].
+    #[arg(long)]
+    work_dir: Option<PathBuf>,
+    /// Retry commits that failed to build or run before.
+    #[arg(long)]
+    retry_failed: bool,
+    /// Keep a run of another series on timelines of its own instead of refusing it.
+    #[arg(long)]
+    allow_mixed: bool,
+}
+
+impl SuiteArgs {
+    fn options(&self, store: &std::path::Path) -> anyhow::Result<CollectOptions> {
+        let repo = git::repository_root(&crate::paths::workspace_root())?;
+        let mut suite_args = vec![
+            "--threads".to_string(),
+            self.threads.to_string(),
+            "--repeat".into(),
+            self.repeat.to_string(),
+            "--jobs".into(),
+            "1".into(),
+        ];
+        let survey = self.survey_dir.clone().or_else(|| super::path_from_env(SURVEY_DIR_ENV));
+        if let Some(dir) = survey {
+            let dir =
+                dir.canonicalize().map_err(|e| anyhow::anyhow!("--survey-dir {}: {e}", dir.display()))?;
+            suite_args.extend(["--survey-dir".to_string(), dir.display().to_string()]);
+        }
+        if let Some(s) = &self.scenarios {
+            suite_args.extend(["--scenarios".to_string(), s.display().to_string()]);
+        }
+        let work_dir = self
+            .work_dir
+            .clone()
+            .unwrap_or_else(|| store.parent().unwrap_or(std::path::Path::new(".")).join("work"));
+        Ok(CollectOptions {
+            repo,
+            work_dir,
+            suite_args,
+            retry_failed: self.retry_failed,
+            mixing: if self.allow_mixed { Mixing::Allow } else { Mixing::Refuse },
+        })
+    }
+}
+
+fn print_outcome(label: &str, outcome: &Outcome) {
+    match outcome {
+        Outcome::Recorded(Recorded::Added { cases, measurements, .. }) => {
+            println!("{label}: recorded ({cases} cases, {measurements} values)")
+        }
+        Outcome::Recorded(Recorded::AlreadyThere { .. }) | Outcome::AlreadyRecorded => {
+            println!("{label}: already recorded")
+        }
+        Outcome::FailedBefore(why) => {
+            println!("{label}: skipped, failed before ({why}; --retry-failed runs it again)")
+        }
+        Outcome::Failed { stage, message } => println!("{label}: {stage} failed: {message}"),
+    }
+}
+
+pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
+    match command {
+        HistoryCommand::Record { reports, store, allow_mixed, allow_dirty } => {
+            let path = store.path();
+            // Every run is read before the store is touched: a bad file records nothing.
+            let runs = reports.iter().map(|r| run_record::read_run(r)).collect::<Result<Vec<_>, _>>()?;
+            if let Some((r, _)) = reports.iter().zip(&runs).find(|(_, run)| run.dirty && !allow_dirty) {
+                anyhow::bail!(
+                    "{}: made from a tree that differed from its commit (git_dirty); its values belong to no commit. --allow-dirty records it anyway",
+                    r.display()
+                );
+            }
+            let mut history = HistoryStore::open_or_create(&path)?;
+            let mixing = if allow_mixed { Mixing::Allow } else { Mixing::Refuse };
+            for (r, run) in reports.iter().zip(&runs) {
+                let outcome = history.record(run, &r.display().to_string(), mixing)?;
+                let label = format!("{} ({})", r.display(), &run.commit[..run.commit.len().min(12)]);
+                print_outcome(&label, &Outcome::Recorded(outcome));
+            }
+            println!("store: {}", path.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        HistoryCommand::Run { revisions, steps, store, suite } => {
+            let path = store.path();
+            let options = suite.options(&path)?;
+            let mut commits = git::expand(&options.repo, &revisions)?;
+            if let Some(n) = steps {
+                commits = git::thin(&commits, n);
+            }
+            let mut history = HistoryStore::open_or_create(&path)?;
+            println!("{} commit(s) to run: {}", commits.len(), options.request());
+            let total = commits.len();
+            let outcomes = collect::run_commits(&mut history, &commits, &options, |i, sha, outcome| {
+                print_outcome(&format!("[{}/{total}] {}", i + 1, &sha[..12]), outcome)
+            })?;
+            let failed = outcomes.iter().filter(|o| matches!(o, Outcome::Failed { .. })).count();
+            println!("store: {}", path.display());
+            Ok(if failed > 0 { ExitCode::from(super::EXIT_CASE_FAILED) } else { ExitCode::SUCCESS })
+        }
+        HistoryCommand::Show { store, out, repo } => {
+            let path = store.path();
+            let history_store = HistoryStore::open_existing(&path)?;
+            let repo = git::repository_root(&repo.unwrap_or_else(crate::paths::workspace_root))?;
+            let built = timeline::build(&history_store, &repo)?;
+            let out = out.unwrap_or_else(|| path.parent().unwrap_or(std::path::Path::new(".")).join("page"));
+            let index = page::write_page(&out, &built, &path)?;
+            let steps = page::all_steps(&built);
+            println!(
+                "{} commits, {} timelines, {} step(s){}",
+                built.commits.len(),
+                built.timelines.len(),
+                steps.len(),
+                if steps.is_empty() { "" } else { ":" }
+            );
+            for (t, s) in steps {
+                println!(
+                    "  {} / {} {}: {:.4} -> {:.4} ({:+.1}%), {}",
+                    t.scenario,
+                    t.method,
+                    t.measure.key(),
+                    s.before,
+                    s.after,
+                    100.0 * s.relative,
+                    page::step_commit(&built, s)
+                );
+            }
+            println!("history page: {}", index.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        HistoryCommand::Find { measure, scenario, method, store, suite } => {
+            let measure = Measure::from_key(&measure).ok_or_else(|| {
+                let keys: Vec<&str> = Measure::all().into_iter().map(Measure::key).collect();
+                anyhow::anyhow!("unknown measure `{measure}`; one of {}", keys.join(", "))
+            })?;
+            let path = store.path();
+            let options = suite.options(&path)?;
+            let mut history_store = HistoryStore::open_existing(&path)?;
+            let target = FindTarget { measure, scenario, method };
+            let found = collect::find(&mut history_store, &target, &options, |sha, outcome| {
+                print_outcome(&format!("bisect {}", &sha[..12]), outcome)
+            })?;
+            if found.is_empty() {
+                println!("no step of {} found", measure.key());
+            }
+            for f in &found {
+                println!(
+                    "{} / {} {}: {:.4} -> {:.4} ({:+.1}%), made by {} {} ({} commit(s) run)",
+                    f.scenario,
+                    f.method,
+                    measure.key(),
+                    f.step.before,
+                    f.step.after,
+                    100.0 * f.step.relative,
+                    f.commit.short(),
+                    f.commit.subject,
+                    f.runs
+                );
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
