@@ -24,17 +24,8 @@ fn run(args: &[&str]) -> anyhow::Result<std::process::ExitCode> {
 fn viewer_after(chromium: &Path, url: &str, flags: &[&str]) -> (String, String) {
     let profile = tempfile::tempdir().unwrap();
     let out = std::process::Command::new(chromium)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--allow-file-access-from-files",
-            "--virtual-time-budget=30000",
-        ])
+        .args(support::HEADLESS)
+        .arg("--virtual-time-budget=30000")
         .args(flags)
         .arg(format!("--user-data-dir={}", profile.path().display()))
         .arg("--dump-dom")

@@ -212,22 +212,25 @@ pub fn images_loaded_in_chromium(chromium: &Path, page: &Path) -> (usize, usize)
     (attribute("data-loaded"), attribute("data-total"))
 }
 
+/// Chromium's flags for a headless run on this machine: no sandbox (root), no background
+/// connections (the closed network refuses them), local files may load each other.
+pub const HEADLESS: [&str; 8] = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--allow-file-access-from-files",
+];
+
 /// The DOM of `url` after headless Chromium ran its scripts, and what Chromium said on stderr.
 pub fn dump_dom(chromium: &Path, url: &str) -> (String, String) {
     let profile = tempfile::tempdir().unwrap();
     let out = std::process::Command::new(chromium)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--allow-file-access-from-files",
-            "--virtual-time-budget=10000",
-        ])
+        .args(HEADLESS)
+        .args(["--disable-gpu", "--virtual-time-budget=10000"])
         .arg(format!("--user-data-dir={}", profile.path().display()))
         .arg("--dump-dom")
         .arg(url)

@@ -68,6 +68,11 @@ fn change(step: &AttributedStep) -> String {
     }
 }
 
+/// A step's measure, before, after, change and commit, escaped for the page.
+fn step_fields(history: &History, t: &Timeline, s: &AttributedStep) -> [String; 5] {
+    [escape(t.measure.key()), value(s.before), value(s.after), change(s), escape(&step_commit(history, s))]
+}
+
 fn steps_markdown(history: &History) -> String {
     let mut md = String::from("| series | scenario | method | measure | before | after | change | commit |\n|---|---|---|---|---|---|---|---|\n");
     for (t, s) in all_steps(history) {
@@ -119,17 +124,11 @@ fn render(history: &History, store: &Path, sections: &str) -> String {
     } else {
         page.push_str("<table><tr><th>scenario</th><th>method</th><th>measure</th><th>before</th><th>after</th><th>change</th><th>commit</th></tr>\n");
         for (t, s) in &steps {
-            let _ = writeln!(
-                page,
-                "<tr class=\"step\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                escape(&t.scenario),
-                escape(&t.method),
-                escape(t.measure.key()),
-                value(s.before),
-                value(s.after),
-                change(s),
-                escape(&step_commit(history, s))
-            );
+            let cells: Vec<String> = [escape(&t.scenario), escape(&t.method)]
+                .into_iter()
+                .chain(step_fields(history, t, s))
+                .collect();
+            let _ = writeln!(page, "<tr class=\"step\"><td>{}</td></tr>", cells.join("</td><td>"));
         }
         page.push_str("</table>\n");
     }
@@ -195,15 +194,9 @@ fn section(page: &mut String, history: &History, timelines: &[&Timeline], png: &
     } else {
         page.push_str("<ul>");
         for (t, s) in steps {
-            let _ = write!(
-                page,
-                "<li class=\"step\">{}: {} → {} ({}), {}</li>",
-                escape(t.measure.key()),
-                value(s.before),
-                value(s.after),
-                change(s),
-                escape(&step_commit(history, s))
-            );
+            let [measure, before, after, change, commit] = step_fields(history, t, s);
+            let _ =
+                write!(page, "<li class=\"step\">{measure}: {before} → {after} ({change}), {commit}</li>");
         }
         page.push_str("</ul>");
     }
