@@ -17,6 +17,8 @@ use crate::report::html::escape;
 const COLUMNS: usize = 3;
 /// One panel's pixel size.
 const PANEL: (u32, u32) = (520, 300);
+/// The figure's title row, pixels.
+const TITLE: u32 = 30;
 
 /// Write the page of `history` into `out`; returns the index's path.
 pub fn write_page(out: &Path, history: &History, store: &Path) -> Result<PathBuf, HistoryError> {
@@ -97,6 +99,23 @@ fn value(v: f64) -> String {
         format!("{v:.3e}")
     } else {
         format!("{v:.4}")
+    }
+}
+
+/// An axis label: four significant digits, no trailing zeros.
+fn axis_value(v: f64) -> String {
+    if v == 0.0 {
+        return "0".to_string();
+    }
+    if v.abs() < 1e-3 || v.abs() >= 1e6 {
+        return format!("{v:.2e}");
+    }
+    let decimals = (3 - v.abs().log10().floor() as i32).max(0) as usize;
+    let text = format!("{v:.decimals$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
     }
 }
 
@@ -210,7 +229,7 @@ fn err<E: std::fmt::Display>(e: E) -> String {
 /// A case's figure: one panel per measure it has.
 fn draw_case(path: &Path, history: &History, timelines: &[&Timeline]) -> Result<(), HistoryError> {
     let rows = timelines.len().div_ceil(COLUMNS).max(1);
-    let size = (PANEL.0 * COLUMNS as u32, PANEL.1 * rows as u32);
+    let size = (PANEL.0 * COLUMNS as u32, PANEL.1 * rows as u32 + TITLE);
     let temporary = path.with_file_name(format!(
         ".{}.partial.png",
         path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
@@ -219,6 +238,10 @@ fn draw_case(path: &Path, history: &History, timelines: &[&Timeline]) -> Result<
     {
         let root = BitMapBackend::new(&temporary, size).into_drawing_area();
         root.fill(&WHITE).map_err(|e| fail(err(e)))?;
+        let title = timelines
+            .first()
+            .map_or(String::new(), |t| format!("{} / {} ({})", t.scenario, t.method, t.series));
+        let root = root.titled(&title, ("sans-serif", 18)).map_err(|e| fail(err(e)))?;
         let panels = root.split_evenly((rows, COLUMNS));
         for (panel, t) in panels.iter().zip(timelines) {
             draw_panel(panel, history, t).map_err(fail)?;
@@ -264,7 +287,7 @@ fn draw_panel<DB: DrawingBackend>(
         .x_labels(n.min(24))
         .x_label_formatter(&label)
         .x_label_style(("sans-serif", 10).into_font().transform(FontTransform::Rotate90))
-        .y_label_formatter(&|v| value(*v))
+        .y_label_formatter(&|v| axis_value(*v))
         .label_style(("sans-serif", 11))
         .draw()
         .map_err(err)?;

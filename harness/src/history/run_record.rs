@@ -34,7 +34,7 @@ pub struct RunRecord {
 /// What runs must share for their values to be one timeline.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct SeriesKey {
-    /// results.json's `data_source` (survey, procedural, mesh files).
+    /// [`data_source_kind`] of results.json's `data_source`.
     pub data_source: String,
     /// CPU model, logical cores, memory, threads and jobs: timings of two classes do not compare.
     pub machine_class: String,
@@ -112,12 +112,29 @@ pub fn parse_run(bytes: &[u8]) -> Result<RunRecord, String> {
         commit,
         dirty,
         started_utc: text(run, "started_utc").unwrap_or_default(),
-        series: SeriesKey { data_source, machine_class },
+        series: SeriesKey { data_source: data_source_kind(&data_source), machine_class },
         data_files: data_files(provenance.get("inputs")),
         repetitions: count(run, "repetitions").max(1),
         provenance: provenance.to_string(),
         cases,
     })
+}
+
+/// What data a run read, from results.json's `data_source` line ("survey data from DIR for 8
+/// scenario(s), procedural look-alikes for 3"): `survey` when a survey directory was given, else
+/// `procedural look-alikes`, else `mesh files`. The directory and the counts are left out: the
+/// same survey elsewhere is the same data (its files' hashes say so), and a commit that adds a
+/// scenario does not start another series.
+pub fn data_source_kind(line: &str) -> String {
+    if line.contains("survey data from") {
+        "survey".to_string()
+    } else if line.contains("procedural look-alikes") {
+        "procedural look-alikes".to_string()
+    } else if line.contains("mesh files") {
+        "mesh files".to_string()
+    } else {
+        line.to_string()
+    }
 }
 
 fn text(v: &Value, key: &str) -> Option<String> {
@@ -224,6 +241,19 @@ mod tests {
         assert_eq!(a.data_files, vec![("bar.off".to_string(), "22".to_string())]);
         let moved = run_json("").replace("/d/bar.off", "/elsewhere/bar.off").replace("\"11\"", "\"99\"");
         assert_eq!(parse_run(moved.as_bytes()).unwrap().data_files, a.data_files);
+    }
+
+    #[test]
+    fn the_data_source_is_its_kind_without_directory_or_counts() {
+        let a =
+            data_source_kind("survey data from /a/survey for 8 scenario(s), procedural look-alikes for 3");
+        assert_eq!(
+            a,
+            data_source_kind("survey data from /elsewhere for 9 scenario(s), procedural look-alikes for 3")
+        );
+        assert_eq!(a, "survey");
+        assert_eq!(data_source_kind("procedural look-alikes of the survey shapes"), "procedural look-alikes");
+        assert_eq!(data_source_kind("mesh files named by the scenarios"), "mesh files");
     }
 
     #[test]
