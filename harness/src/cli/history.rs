@@ -217,16 +217,7 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
                 if steps.is_empty() { "" } else { ":" }
             );
             for (t, s) in steps {
-                println!(
-                    "  {} / {} {}: {:.4} -> {:.4} ({:+.1}%), {}",
-                    t.scenario,
-                    t.method,
-                    t.measure.key(),
-                    s.before,
-                    s.after,
-                    100.0 * s.relative,
-                    page::step_commit(&built, s)
-                );
+                println!("  {}", page::step_line(&built, t, s));
             }
             println!("history page: {}", index.display());
             Ok(ExitCode::SUCCESS)

@@ -10,8 +10,9 @@
 //!   when the code does; the floor keeps a one-iteration change from a rounding difference small.
 //! - peak memory: 10% or 8 MiB. The counter is a lower bound that reads 0 for small cases
 //!   (harness/src/memory.rs) and moves with the allocator's reuse.
-//! - quality: half the regression gate's tolerance for the value (metrics::METRICS), or 1% for an
-//!   ungated measure: what the gate calls a change is about what a step is here.
+//! - quality: half the regression gate's tolerance for the value (metrics::METRICS), or for an
+//!   ungated measure 1% with an absolute floor ([`ungated_absolute`]): what the gate calls a change
+//!   is about what a step is here.
 
 use crate::metrics::{Metric, MetricSpec, Tolerance};
 
@@ -47,6 +48,17 @@ pub const COUNT_NOISE: f64 = 0.5;
 pub const MEMORY_NOISE: (f64, f64) = (0.10, 8.0);
 /// The noise of a quality measure the gate does not judge: relative.
 pub const UNGATED_NOISE: f64 = 0.01;
+
+/// The absolute floor of an ungated measure: below what anyone could see. A handle residual of
+/// 1e-10 diagonals is the solver's rounding and moves with it; a millionth of the diagonal is the
+/// least that counts; a hundredth of a degree for turns.
+fn ungated_absolute(metric: Metric) -> f64 {
+    match metric {
+        Metric::HandleResidual | Metric::RmsToArap | Metric::MaxToArap => 1e-6,
+        Metric::TurnBeyondHandles | Metric::TurnToArap => 0.01,
+        _ => 1e-12,
+    }
+}
 
 impl Measure {
     /// Every measure, in the order the page shows them.
@@ -98,7 +110,9 @@ impl Measure {
             Measure::PeakMemory => Noise::Memory,
             Measure::Quality(m) => match m.spec().gate {
                 Some(t) => Noise::Tolerance(t),
-                None => Noise::Tolerance(Tolerance { relative: UNGATED_NOISE, absolute: 1e-12 }),
+                None => {
+                    Noise::Tolerance(Tolerance { relative: UNGATED_NOISE, absolute: ungated_absolute(m) })
+                }
             },
         }
     }

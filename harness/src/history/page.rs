@@ -50,10 +50,36 @@ pub fn all_steps(history: &History) -> Vec<(&Timeline, &AttributedStep)> {
     history.timelines.iter().flat_map(|t| t.steps.iter().map(move |s| (t, s))).collect()
 }
 
+/// The first `SUBJECT_CHARS` characters of a commit subject are shown.
+const SUBJECT_CHARS: usize = 90;
+
+/// `subject`, cut after [`SUBJECT_CHARS`] characters.
+pub fn short_subject(subject: &str) -> String {
+    if subject.chars().count() <= SUBJECT_CHARS {
+        subject.to_string()
+    } else {
+        format!("{}…", subject.chars().take(SUBJECT_CHARS).collect::<String>())
+    }
+}
+
+/// One line on a step of `t`: where, how much, which commit.
+pub fn step_line(history: &History, t: &Timeline, s: &AttributedStep) -> String {
+    format!(
+        "{} / {} {}: {} -> {} ({}), {}",
+        t.scenario,
+        t.method,
+        t.measure.key(),
+        value(s.before),
+        value(s.after),
+        change(s),
+        step_commit(history, s)
+    )
+}
+
 /// The commit a step is named with: the commit that made it, or the range it lies in.
 pub fn step_commit(history: &History, step: &AttributedStep) -> String {
     match step.made_by {
-        Some(c) => format!("{} {}", history.commits[c].short(), history.commits[c].subject),
+        Some(c) => format!("{} {}", history.commits[c].short(), short_subject(&history.commits[c].subject)),
         None => format!(
             "between {} and {} (`harness history find` narrows it)",
             history.commits[step.from].short(),
@@ -180,7 +206,7 @@ fn render(history: &History, store: &Path, sections: &str) -> String {
             "<tr><td>{i}</td><td><code>{}</code></td><td>{}</td><td>{changed}</td><td>{made}</td><td>{}</td></tr>",
             c.short(),
             escape(&c.date),
-            escape(&c.subject.chars().take(140).collect::<String>())
+            escape(&short_subject(&c.subject))
         );
     }
     page.push_str("</table></section>\n");
