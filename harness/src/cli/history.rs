@@ -43,6 +43,14 @@ pub(super) enum HistoryCommand {
         #[command(flatten)]
         suite: SuiteArgs,
     },
+    /// Remove every run of the commits from the store (a run spoiled by a loaded machine, say),
+    /// so that `history run` runs them again.
+    Forget {
+        #[arg(required = true)]
+        commits: Vec<String>,
+        #[command(flatten)]
+        store: StoreArgs,
+    },
     /// Write the history page: timelines per scenario × method (PNG), steps named with commits.
     Show {
         #[command(flatten)]
@@ -200,6 +208,16 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
             let failed = outcomes.iter().filter(|o| matches!(o, Outcome::Failed { .. })).count();
             println!("store: {}", path.display());
             Ok(if failed > 0 { ExitCode::from(super::EXIT_CASE_FAILED) } else { ExitCode::SUCCESS })
+        }
+        HistoryCommand::Forget { commits, store } => {
+            let path = store.path();
+            let repo = git::repository_root(&crate::paths::workspace_root())?;
+            let mut history = HistoryStore::open_existing(&path)?;
+            for c in &commits {
+                let sha = git::resolve(&repo, c).unwrap_or_else(|_| c.clone());
+                println!("{c}: {} run(s) removed", history.forget(&sha)?);
+            }
+            Ok(ExitCode::SUCCESS)
         }
         HistoryCommand::Show { store, out, repo } => {
             let path = store.path();

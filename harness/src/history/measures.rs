@@ -8,8 +8,9 @@
 //!   (docs/results.md, "timing noise"); a spread within one run does not see that.
 //! - iterations: half an iteration. The built-in methods are deterministic, so a count moves only
 //!   when the code does; the floor keeps a one-iteration change from a rounding difference small.
-//! - peak memory: 10% or 8 MiB. The counter is a lower bound that reads 0 for small cases
-//!   (harness/src/memory.rs) and moves with the allocator's reuse.
+//! - peak memory: 10% or 32 MiB. The counter is a lower bound that reads 0 for small cases
+//!   (harness/src/memory.rs) and moves with the allocator's reuse: the survey history read 3, 56
+//!   and 3 MiB for one unchanged case (bar-incremental / scale_aware at 1d0f40c, b1bfac9, 1e5b923).
 //! - quality: half the regression gate's tolerance for the value (metrics::METRICS), or for an
 //!   ungated measure 1% with an absolute floor ([`ungated_absolute`]): what the gate calls a change
 //!   is about what a step is here.
@@ -45,7 +46,7 @@ pub const TIMING_NOISE: f64 = 0.10;
 /// The floor of a count's noise, iterations.
 pub const COUNT_NOISE: f64 = 0.5;
 /// The floor of peak memory's noise: relative and MiB.
-pub const MEMORY_NOISE: (f64, f64) = (0.10, 8.0);
+pub const MEMORY_NOISE: (f64, f64) = (0.10, 32.0);
 /// The noise of a quality measure the gate does not judge: relative.
 pub const UNGATED_NOISE: f64 = 0.01;
 

@@ -299,10 +299,12 @@ fn draw_panel<DB: DrawingBackend>(
         .y_label_area_size(64)
         .build_cartesian_2d(-0.5..(n as f64 - 0.5), y0..y1)
         .map_err(err)?;
+    // Commits by their number in the page's commits table: seven-character hashes side by side do
+    // not fit under a panel of a dozen commits.
     let label = |x: &f64| {
         let i = x.round();
         if (x - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < n {
-            history.commits[i as usize].short().to_string()
+            format!("{i}")
         } else {
             String::new()
         }
@@ -312,7 +314,7 @@ fn draw_panel<DB: DrawingBackend>(
         .disable_x_mesh()
         .x_labels(n.min(24))
         .x_label_formatter(&label)
-        .x_label_style(("sans-serif", 10).into_font().transform(FontTransform::Rotate90))
+        .x_desc("commit (# of the commits table)")
         .y_label_formatter(&|v| axis_value(*v))
         .label_style(("sans-serif", 11))
         .draw()

@@ -407,6 +407,22 @@ impl HistoryStore {
         Ok(n > 0)
     }
 
+    /// Remove every run of `commit` (a full hash) with its cases and values, and its failures: for a
+    /// run spoiled by something outside it (a loaded machine), before running the commit again.
+    /// Returns the runs removed.
+    pub fn forget(&mut self, commit: &str) -> Result<usize, HistoryError> {
+        let path = self.path.clone();
+        let sql = move |error| HistoryError::Sqlite { path: path.clone(), error };
+        let tx = self.conn.transaction().map_err(&sql)?;
+        let runs = "SELECT id FROM runs WHERE git_commit = ?1";
+        tx.execute(&format!("DELETE FROM measurements WHERE run IN ({runs})"), [commit]).map_err(&sql)?;
+        tx.execute(&format!("DELETE FROM cases WHERE run IN ({runs})"), [commit]).map_err(&sql)?;
+        let removed = tx.execute("DELETE FROM runs WHERE git_commit = ?1", [commit]).map_err(&sql)?;
+        tx.execute("DELETE FROM failures WHERE git_commit = ?1", [commit]).map_err(&sql)?;
+        tx.commit().map_err(&sql)?;
+        Ok(removed)
+    }
+
     /// Keep that `commit` failed at `stage` for `series` (replacing an earlier failure).
     pub fn record_failure(&self, failure: &Failure) -> Result<(), HistoryError> {
         self.conn
@@ -484,6 +500,12 @@ mod tests {
         assert_eq!(count(&store), before);
         store.record(&run("bbb", "CPU", 1.6), "b", Mixing::Refuse).unwrap();
         assert_eq!(count(&store).0, 2);
+        assert_eq!(store.forget("aaa").unwrap(), 1);
+        assert_eq!(count(&store), (1, 3), "the forgotten run's values stayed");
+        assert!(matches!(
+            store.record(&run("aaa", "CPU", 1.5), "a", Mixing::Refuse).unwrap(),
+            Recorded::Added { .. }
+        ));
     }
 
     #[test]
