@@ -265,7 +265,7 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
                     f.step.after,
                     100.0 * f.step.relative,
                     f.commit.short(),
-                    f.commit.subject,
+                    page::short_subject(&f.commit.subject),
                     f.runs
                 );
             }

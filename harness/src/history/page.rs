@@ -64,16 +64,13 @@ pub fn short_subject(subject: &str) -> String {
 
 /// One line on a step of `t`: where, how much, which commit.
 pub fn step_line(history: &History, t: &Timeline, s: &AttributedStep) -> String {
-    format!(
-        "{} / {} {}: {} -> {} ({}), {}",
-        t.scenario,
-        t.method,
-        t.measure.key(),
-        value(s.before),
-        value(s.after),
-        change(s),
-        step_commit(history, s)
-    )
+    let [measure, before, after, change, commit] = step_texts(history, t, s);
+    format!("{} / {} {measure}: {before} -> {after} ({change}), {commit}", t.scenario, t.method)
+}
+
+/// A step's measure, before, after, change and commit, as text.
+fn step_texts(history: &History, t: &Timeline, s: &AttributedStep) -> [String; 5] {
+    [t.measure.key().to_string(), value(s.before), value(s.after), change(s), step_commit(history, s)]
 }
 
 /// The commit a step is named with: the commit that made it, or the range it lies in.
@@ -96,9 +93,9 @@ fn change(step: &AttributedStep) -> String {
     }
 }
 
-/// A step's measure, before, after, change and commit, escaped for the page.
+/// [`step_texts`] escaped for the page.
 fn step_fields(history: &History, t: &Timeline, s: &AttributedStep) -> [String; 5] {
-    [escape(t.measure.key()), value(s.before), value(s.after), change(s), escape(&step_commit(history, s))]
+    step_texts(history, t, s).map(|text| escape(&text))
 }
 
 fn steps_markdown(history: &History) -> String {
@@ -106,15 +103,11 @@ fn steps_markdown(history: &History) -> String {
     for (t, s) in all_steps(history) {
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} |",
             t.series,
             t.scenario,
             t.method,
-            t.measure.key(),
-            value(s.before),
-            value(s.after),
-            change(s),
-            step_commit(history, s)
+            step_texts(history, t, s).join(" | ")
         );
     }
     md
