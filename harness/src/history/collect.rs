@@ -82,7 +82,7 @@ fn run_commit(
     if store.has_request(sha, request)? {
         return Ok(Outcome::AlreadyRecorded);
     }
-    if let Some(f) = store.failures()?.into_iter().find(|f| f.commit == sha && f.series == request) {
+    if let Some(f) = store.failures()?.into_iter().find(|f| f.commit == sha && f.request == request) {
         if !options.retry_failed {
             return Ok(Outcome::FailedBefore(format!("{}: {}", f.stage, f.message)));
         }
@@ -103,7 +103,7 @@ fn run_commit(
         let message = format!("{message} (log: {})", log_path.display());
         store.record_failure(&Failure {
             commit: sha.to_string(),
-            series: request.to_string(),
+            request: request.to_string(),
             stage: stage.into(),
             message: message.clone(),
         })?;

@@ -118,7 +118,7 @@ pub struct StoredValue {
 pub struct Failure {
     pub commit: String,
     /// The `history run` request it failed in ([`super::collect::CollectOptions::request`]).
-    pub series: String,
+    pub request: String,
     pub stage: String,
     pub message: String,
 }
@@ -182,10 +182,6 @@ impl HistoryStore {
         }
         conn.execute_batch("PRAGMA foreign_keys = ON;").map_err(sql)?;
         Ok(HistoryStore { conn, path: path.to_path_buf() })
-    }
-
-    pub fn path(&self) -> &Path {
-        &self.path
     }
 
     fn sql(&self) -> impl Fn(rusqlite::Error) -> HistoryError + '_ {
@@ -423,14 +419,14 @@ impl HistoryStore {
         Ok(removed)
     }
 
-    /// Keep that `commit` failed at `stage` for `series` (replacing an earlier failure).
+    /// Keep that `commit` failed at `stage` for its request (replacing an earlier failure).
     pub fn record_failure(&self, failure: &Failure) -> Result<(), HistoryError> {
         self.conn
             .execute(
                 "INSERT OR REPLACE INTO failures (git_commit, request, stage, message, recorded_utc) VALUES (?1, ?2, ?3, ?4, ?5)",
                 params![
                     failure.commit,
-                    failure.series,
+                    failure.request,
                     failure.stage,
                     failure.message,
                     crate::provenance::utc_timestamp(std::time::SystemTime::now())
@@ -441,9 +437,9 @@ impl HistoryStore {
     }
 
     /// Forget a failure (a retried commit).
-    pub fn clear_failure(&self, commit: &str, series: &str) -> Result<(), HistoryError> {
+    pub fn clear_failure(&self, commit: &str, request: &str) -> Result<(), HistoryError> {
         self.conn
-            .execute("DELETE FROM failures WHERE git_commit = ?1 AND request = ?2", params![commit, series])
+            .execute("DELETE FROM failures WHERE git_commit = ?1 AND request = ?2", params![commit, request])
             .map_err(self.sql())?;
         Ok(())
     }
@@ -455,7 +451,7 @@ impl HistoryStore {
             .map_err(self.sql())?;
         let rows = stmt
             .query_map([], |r| {
-                Ok(Failure { commit: r.get(0)?, series: r.get(1)?, stage: r.get(2)?, message: r.get(3)? })
+                Ok(Failure { commit: r.get(0)?, request: r.get(1)?, stage: r.get(2)?, message: r.get(3)? })
             })
             .map_err(self.sql())?
             .collect::<Result<Vec<_>, _>>()

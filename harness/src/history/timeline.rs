@@ -64,7 +64,7 @@ pub struct History {
     pub method_change: Vec<Option<bool>>,
     pub series: Vec<String>,
     pub timelines: Vec<Timeline>,
-    /// Per series, scenario and method: (commit index, status) where the status's kind changed.
+    /// The cases whose verdict kind changed between consecutive commits.
     pub status_changes: Vec<StatusChange>,
 }
 
