@@ -1,5 +1,6 @@
 //! Cross-checks against libigl on the survey meshes (run by `scripts/test`, which installs the pinned
-//! Python packages): operators (also the intrinsic Delaunay Laplacian, on the real meshes too when
+//! Python packages; without `$DEFORM_SURVEY_DIR` on the procedural look-alikes at the survey's sizes,
+//! written as the same files, with the same tolerances: `support::survey_meshes`): operators (also the intrinsic Delaunay Laplacian, on the real meshes too when
 //! `$DEFORM_REAL_MESHES_DIR` is set) to 1e-10 relative, ARAP to RMS distance <= 1e-3 of the bbox
 //! diagonal.
 
@@ -9,7 +10,7 @@ use std::collections::HashMap;
 
 use methods::operators::{cotan_laplacian, lumped_mass, IntrinsicTriangulation, MassKind};
 use methods::NoObserver;
-use support::{igl_reference, python, read_rows, survey_case, survey_dir};
+use support::{igl_reference, python, read_rows, survey_case, survey_meshes};
 
 const MESHES: [&str; 4] = ["cylinder", "bar", "cactus", "plane"];
 
@@ -31,7 +32,8 @@ fn sparse_relative_error(ours: &HashMap<(usize, usize), f64>, theirs: &HashMap<(
 
 #[test]
 fn cotan_laplacian_and_mass_match_libigl() {
-    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    let Some(py) = python() else { return };
+    let dir = survey_meshes().dir;
     for name in MESHES {
         let mesh_path = dir.join(format!("{name}.off"));
         let mesh = meshes::io::read_mesh(&mesh_path).unwrap();
@@ -81,7 +83,8 @@ fn entry_map(l: &faer::sparse::SparseColMat<usize, f64>) -> HashMap<(usize, usiz
 
 #[test]
 fn intrinsic_delaunay_laplacian_matches_libigl() {
-    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    let Some(py) = python() else { return };
+    let dir = survey_meshes().dir;
     let mut paths: Vec<std::path::PathBuf> = MESHES.iter().map(|n| dir.join(format!("{n}.off"))).collect();
     // The real meshes only when named (scripts/test sets the variable).
     if let Some(real) = std::env::var_os("DEFORM_REAL_MESHES_DIR").and_then(|_| support::real_meshes_dir()) {
@@ -110,18 +113,28 @@ fn intrinsic_delaunay_laplacian_matches_libigl() {
 
 #[test]
 fn arap_matches_libigl_arap_solve() {
-    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    let Some(py) = python() else { return };
+    let dir = survey_meshes().dir;
     for name in ["cylinder", "bar", "cactus"] {
         let case = ArapCase::new(&dir, name);
         for iterations in [10usize, 100] {
             let theirs = case.libigl_arap(&py, iterations);
             let ours = case.our_arap(iterations);
             let rms = harness::metrics::rms_distance(&ours, &theirs, case.mesh.bbox_diagonal());
-            println!("{name}: {iterations} iterations, RMS distance to libigl / bbox diagonal = {rms:.2e}");
+            let exact = case.float64_arap(&py, iterations);
+            let to_exact = max_vertex_distance(&ours, &exact) / case.mesh.bbox_diagonal();
+            println!(
+                "{name}: {iterations} iterations, RMS distance to libigl / bbox diagonal = {rms:.2e}, \
+                 max distance to the float64 SPOKES reference {to_exact:.2e}"
+            );
             assert!(
                 rms <= 1e-3,
                 "{name}: arap after {iterations} iterations is {rms:e} x diagonal from libigl's"
             );
+            // The same iteration in double precision (igl_reference.py `arap_float64`): ours must
+            // agree to rounding (measured <= 2.1e-12 on the survey meshes and the look-alikes), so what remains
+            // against libigl is libigl's single-precision rotation fit.
+            assert!(to_exact <= 1e-10, "{name}: {to_exact:e} x diagonal from the float64 reference");
         }
     }
 }
@@ -168,6 +181,23 @@ impl ArapCase {
         read_rows(&out).into_iter().map(|r| [r[0], r[1], r[2]]).collect()
     }
 
+    /// The same SPOKES iteration as libigl's in float64 numpy (igl_reference.py `arap_float64`),
+    /// `#V x 3`.
+    fn float64_arap(&self, python: &std::path::Path, iterations: usize) -> Vec<[f64; 3]> {
+        let out = self.work.path().join(format!("f64-{iterations}.txt"));
+        igl_reference(
+            python,
+            &[
+                "arap_float64",
+                self.mesh_path.to_str().unwrap(),
+                self.constraints.to_str().unwrap(),
+                &iterations.to_string(),
+                out.to_str().unwrap(),
+            ],
+        );
+        read_rows(&out).into_iter().map(|r| [r[0], r[1], r[2]]).collect()
+    }
+
     /// Our `arap` after exactly `iterations` iterations (no early exit), from the rest shape.
     fn our_arap(&self, iterations: usize) -> Vec<[f64; 3]> {
         // libigl's arap uses the mesh's cotangent weights and the plain local/global iteration.
@@ -200,7 +230,8 @@ fn largest_angle_sine(ours: &faer::Mat<f64>, reference: &faer::Mat<f64>, mass: &
 
 #[test]
 fn manifold_harmonics_match_scipy_eigsh() {
-    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    let Some(py) = python() else { return };
+    let dir = survey_meshes().dir;
     // scipy computes a few more pairs so that a cluster cut at k is still compared with its full span.
     const EXTRA: usize = 8;
     for name in MESHES {
@@ -291,7 +322,8 @@ fn json_f64(v: &serde_json::Value, path: &[&str]) -> f64 {
 /// real difference in formula, corner order or vertex indexing.
 #[test]
 fn peers_corner_angles_and_face_areas_match_pymeshlab() {
-    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    let Some(py) = python() else { return };
+    let dir = survey_meshes().dir;
     for name in MESHES {
         let mesh_path = dir.join(format!("{name}.off"));
         let mesh = meshes::io::read_mesh(&mesh_path).unwrap();
@@ -341,9 +373,16 @@ const ARAP_CASES: [(&str, &[usize]); 4] =
 /// from libigl there, 6.2e-4 max vertex distance / diagonal after 10 iterations (7.7e-3 after 100).
 /// Bounds: 1e-4 of the diagonal (2.3x the largest figure) on the three 5-6K-vertex meshes, 1e-3 (the
 /// RMS bound of the libigl test; 1.6x) on the plane. Also asserted: Hausdorff <= max vertex distance.
+///
+/// On the procedural look-alikes (no survey data, issue 60), measured: cylinder 4.2e-5, 2.5e-5; bar
+/// 1.5e-4, 1.2e-5; cactus 7.4e-6, 6.4e-5; plane 6.2e-4. The bar after 10 iterations is the one figure
+/// over 1e-4, at the bar's edges, and it is libigl's: the float64 numpy SPOKES iteration
+/// (`arap_float64`) is 1.5e-4 from libigl there and 1.4e-13 from ours. So the bar of the look-alikes
+/// gets the plane's 1e-3 (6.6x its figure); every other bound is the survey's.
 #[test]
 fn peers_arap_hausdorff_distance_to_libigl_arap_is_small() {
-    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    let Some(py) = python() else { return };
+    let support::SurveyMeshes { dir, source } = survey_meshes();
     for (name, iteration_counts) in ARAP_CASES {
         let case = ArapCase::new(&dir, name);
         let (mesh, work) = (&case.mesh, case.work.path());
@@ -374,7 +413,8 @@ fn peers_arap_hausdorff_distance_to_libigl_arap_is_small() {
                 hausdorff <= max_vertex * (1.0 + 1e-6) + 1e-9,
                 "{name}: Hausdorff {hausdorff:e} exceeds the max vertex distance {max_vertex:e}"
             );
-            let bound = if name == "plane" { 1e-3 } else { 1e-4 };
+            let look_alike_bar = name == "bar" && source == support::SurveySource::LookAlikes;
+            let bound = if name == "plane" || look_alike_bar { 1e-3 } else { 1e-4 };
             assert!(
                 hausdorff <= bound,
                 "{name}: after {iterations} iterations ours is {hausdorff:e} x diagonal from libigl's surface"
@@ -408,7 +448,8 @@ fn peers_arap_hausdorff_distance_to_libigl_arap_is_small() {
 /// the two reproduce the same deformation to within a tenth of its size, not closer.
 #[test]
 fn peers_arap_agrees_with_open3d_arap() {
-    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    let Some(py) = python() else { return };
+    let dir = survey_meshes().dir;
     for (name, iteration_counts) in ARAP_CASES {
         let case = ArapCase::new(&dir, name);
         let (mesh, handles, targets) = (&case.mesh, &case.handles, &case.targets);
@@ -453,7 +494,8 @@ fn peers_arap_agrees_with_open3d_arap() {
 /// ~28 s is the 80K-face plane.)
 #[test]
 fn peers_open3d_self_intersection_flags_only_the_crossing_mesh() {
-    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    let Some(py) = python() else { return };
+    let dir = survey_meshes().dir;
     let work = tempfile::tempdir().unwrap();
     // Two triangles with no shared vertex: the second pierces the first's interior along the segment
     // (0.5, 0.5, 0)-(1, 0.25, 0); moved 5 along x it is clear of it.
@@ -506,7 +548,8 @@ fn peers_open3d_self_intersection_flags_only_the_crossing_mesh() {
 #[test]
 fn peers_area_distortion_and_volume_change_match_libigl_and_pymeshlab() {
     use harness::metrics::{area_distortion, volume_change, RestGeometry};
-    let (Some(dir), Some(py)) = (survey_dir(), python()) else { return };
+    let Some(py) = python() else { return };
+    let dir = survey_meshes().dir;
     for name in ["cylinder", "bar", "cactus"] {
         let (mesh, handles, targets) = survey_case(&dir, name);
         let params: toml::Table = "max_iterations = 30".parse().unwrap();

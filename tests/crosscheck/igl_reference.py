@@ -27,6 +27,12 @@ arap MESH CONSTRAINTS ITERATIONS OUT
     no dynamics, max_iter = ITERATIONS, initial guess U = rest positions V.
     OUT: one line per vertex, `x y z`.
 
+arap_float64 MESH CONSTRAINTS ITERATIONS OUT
+    The iteration of `arap` (SPOKES energy, igl.cotmatrix weights, constrained rows moved to their
+    targets first, local step then global step) in float64 numpy/scipy, written here: libigl's
+    rotation fit is single precision, this one is not, so the Rust side can tell libigl's rounding
+    from a difference of its own. Same input and output formats as `arap`.
+
 arap-timing MESH CONSTRAINTS ITERATIONS
     Same set-up as `arap`; times arap_precomputation and arap_solve (max_iter=ITERATIONS; libigl
     has no early exit, so it always runs ITERATIONS iterations), each best of 3 runs, and prints
@@ -214,6 +220,50 @@ def cmd_arap(args):
     write_matrix(args.out, U)
 
 
+def arap_float64(V, F, b, bc, iterations):
+    """SPOKES ARAP in float64: E = sum_i sum_j w_ij |(u_i - u_j) - R_i (v_i - v_j)|^2 with w_ij
+    igl.cotmatrix's off-diagonal entries; local step R_i = polar(S_i), S_i = sum_j w_ij e0_ij e_ij^T
+    (reflections fixed by flipping the last singular vector); global step -L u = sum_j w_ij / 2
+    (R_i + R_j)(v_i - v_j) on the free rows, constrained rows at bc."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spl
+
+    L = sp.csr_matrix(igl.cotmatrix(V, F))
+    n = V.shape[0]
+    free = np.setdiff1d(np.arange(n), b)
+    solve = spl.factorized(-L[free][:, free].tocsc())
+    L_fb = L[free][:, b]
+    coo = L.tocoo()
+    off = coo.row != coo.col
+    rows, cols, w = coo.row[off], coo.col[off], coo.data[off]
+    rest_edges = V[cols] - V[rows]
+    U = V.copy()
+    U[b] = bc
+    for _ in range(iterations):
+        edges = U[cols] - U[rows]
+        S = np.zeros((n, 3, 3))
+        np.add.at(S, rows, w[:, None, None] * rest_edges[:, :, None] * edges[:, None, :])
+        left, _, right_t = np.linalg.svd(S)
+        flip = np.linalg.det(np.einsum("nij,njk->nki", left, right_t)) < 0
+        left[flip, :, 2] *= -1
+        R = np.einsum("nij,njk->nki", left, right_t)  # R_i = V U^T of S_i = U s V^T
+        rhs = np.zeros((n, 3))
+        np.add.at(rhs, rows, (w[:, None] / 2) * np.einsum("nij,nj->ni", R[rows] + R[cols], -rest_edges))
+        for k in range(3):
+            U[free, k] = solve(rhs[free, k] + L_fb @ bc[:, k])
+        U[b] = bc
+    return U
+
+
+def cmd_arap_float64(args):
+    V, F = read_mesh(args.mesh)
+    b, bc = read_vector_constraints(args.constraints, V.shape[0])
+    U = arap_float64(V, F, b, bc, args.iterations)
+    if not np.all(np.isfinite(U)):
+        raise RuntimeError("float64 ARAP produced non-finite positions")
+    write_matrix(args.out, U)
+
+
 def cmd_arap_timing(args):
     V, F = read_mesh(args.mesh)
     b, bc = read_vector_constraints(args.constraints, V.shape[0])
@@ -345,6 +395,13 @@ def build_parser():
     s.add_argument("iterations", type=positive_int)
     s.add_argument("out")
     s.set_defaults(func=cmd_arap)
+
+    s = sub.add_parser("arap_float64", help="the same SPOKES ARAP iteration in float64 numpy")
+    s.add_argument("mesh")
+    s.add_argument("constraints")
+    s.add_argument("iterations", type=positive_int)
+    s.add_argument("out")
+    s.set_defaults(func=cmd_arap_float64)
 
     s = sub.add_parser("arap-timing", help="time libigl ARAP precomputation and iterations")
     s.add_argument("mesh")

@@ -22,35 +22,95 @@ pub fn workspace_root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The survey data directory: `$DEFORM_SURVEY_DIR`, else `../shared/deformation-survey`.
-pub fn survey_dir() -> Option<PathBuf> {
-    let dir = std::env::var_os("DEFORM_SURVEY_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| workspace_root().join("../shared/deformation-survey"));
-    if dir.join("bar.off").is_file() {
-        Some(dir)
-    } else {
-        unavailable("the survey data (DEFORM_SURVEY_DIR)")
+/// The directory named by the environment variable `var`, unless it is unset or empty. Data is
+/// found only through the variables (`scripts/test` sets them from `../shared/` when that exists),
+/// so a run with them unset is a run without the data, wherever the checkout lies.
+fn data_dir_from(var: &str) -> Option<PathBuf> {
+    std::env::var_os(var).filter(|v| !v.is_empty()).map(PathBuf::from)
+}
+
+/// The data directory named by `var` when it holds `marker`. Unset: `None` (a skip, also under
+/// `scripts/test`: a fresh clone has no data, issue 60). Set but without `marker`: a failure under
+/// `scripts/test` (the variable names data that is not there), a skip otherwise.
+fn named_data_dir(var: &str, marker: &str, what: &str) -> Option<PathBuf> {
+    match data_dir_from(var) {
+        Some(dir) if dir.join(marker).is_file() => Some(dir),
+        Some(dir) => unavailable(&format!("{what} ({var} = {}, which has no {marker})", dir.display())),
+        None => {
+            eprintln!("SKIPPED: {what} not named ({var} unset); this test needs the data");
+            None
+        }
     }
+}
+
+/// The survey data directory named by `$DEFORM_SURVEY_DIR`, for the tests about the survey's own
+/// files. The cross-checks use [`survey_meshes`], which falls back to the look-alikes.
+pub fn survey_dir() -> Option<PathBuf> {
+    named_data_dir("DEFORM_SURVEY_DIR", "bar.off", "the survey data")
+}
+
+/// Where the four survey tests' files come from for the cross-checks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SurveySource {
+    /// The Botsch–Sorkine files of `$DEFORM_SURVEY_DIR`.
+    Survey,
+    /// The procedural look-alikes (`meshes::shapes`) at the survey's sizes, written as the same
+    /// `.off`/`.sel`/`.def` files: a fresh clone has no survey data, and the cross-checks still run.
+    LookAlikes,
+}
+
+/// The four survey tests as files: `<name>.off`, `.sel`, `.def` in `dir` for `bar`, `cylinder`,
+/// `cactus`, `plane`.
+#[derive(Clone, Debug)]
+pub struct SurveyMeshes {
+    pub dir: PathBuf,
+    pub source: SurveySource,
+}
+
+/// The survey files of `$DEFORM_SURVEY_DIR` when named, else the procedural look-alikes written once
+/// per test process under cargo's `CARGO_TARGET_TMPDIR` (each file atomically; the shapes are
+/// deterministic, so two processes write the same bytes). The cross-checks run on either with the
+/// same tolerances; which one is printed.
+pub fn survey_meshes() -> SurveyMeshes {
+    // Named but wrong: a failure under scripts/test, else the look-alikes (with the skip message).
+    if data_dir_from("DEFORM_SURVEY_DIR").is_some() {
+        if let Some(dir) = named_data_dir("DEFORM_SURVEY_DIR", "bar.off", "the survey data") {
+            eprintln!("cross-checks on the survey meshes of {}", dir.display());
+            return SurveyMeshes { dir, source: SurveySource::Survey };
+        }
+    }
+    static LOOK_ALIKES: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    let dir = LOOK_ALIKES.get_or_init(|| {
+        let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("survey-look-alikes");
+        std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+        for kind in meshes::shapes::ShapeKind::ALL {
+            let shape = meshes::shapes::generate(kind, meshes::shapes::default_vertex_count(kind))
+                .unwrap_or_else(|e| panic!("{kind}: {e}"));
+            let name = kind.name();
+            meshes::io::write_off(dir.join(format!("{name}.off")), &shape.mesh).unwrap();
+            meshes::io::write_selection(dir.join(format!("{name}.sel")), &shape.selection).unwrap();
+            meshes::io::write_transform(dir.join(format!("{name}.def")), &shape.transform).unwrap();
+        }
+        dir
+    });
+    eprintln!(
+        "cross-checks on the procedural look-alikes in {} (DEFORM_SURVEY_DIR unset; same tolerances)",
+        dir.display()
+    );
+    SurveyMeshes { dir: dir.clone(), source: SurveySource::LookAlikes }
 }
 
 /// The real-mesh directory named by `$DEFORM_REAL_MESHES_DIR` (the scenarios of `configs/real-meshes`
 /// read it from there; `scripts/test` sets it to `../shared/real-meshes`).
 pub fn real_meshes_dir() -> Option<PathBuf> {
-    match std::env::var_os("DEFORM_REAL_MESHES_DIR").map(PathBuf::from) {
-        Some(dir) if dir.join("decimated-knight.off").is_file() => Some(dir),
-        _ => unavailable("the real meshes (DEFORM_REAL_MESHES_DIR)"),
-    }
+    named_data_dir("DEFORM_REAL_MESHES_DIR", "decimated-knight.off", "the real meshes")
 }
 
 /// The real-mesh dataset named by `$DEFORM_DATASET_DIR` (79 meshes and their MANIFEST.csv; the
 /// scenarios of `configs/dataset*` read it from there; `scripts/test` sets it to
 /// `../shared/real-meshes/dataset`).
 pub fn dataset_dir() -> Option<PathBuf> {
-    match std::env::var_os("DEFORM_DATASET_DIR").map(PathBuf::from) {
-        Some(dir) if dir.join("MANIFEST.csv").is_file() => Some(dir),
-        _ => unavailable("the real-mesh dataset (DEFORM_DATASET_DIR)"),
-    }
+    named_data_dir("DEFORM_DATASET_DIR", "MANIFEST.csv", "the real-mesh dataset")
 }
 
 /// The cross-check interpreter: `$DEFORMBENCH_PYTHON` (set up by scripts/python-env).
