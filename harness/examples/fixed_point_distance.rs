@@ -88,7 +88,7 @@ fn main() -> Result<()> {
     };
     let scenario = spec.load(&source)?.scenarios.remove(0);
     let method = args[2].as_str();
-    let configs = harness::paths::workspace_root().join("configs/methods.toml");
+    let configs = harness::paths::project_root()?.join("configs/methods.toml");
     let config: toml::Table = std::fs::read_to_string(&configs)?.parse()?;
     let base = config.get(method).and_then(toml::Value::as_table).cloned().unwrap_or_default();
     let (mut params, mut reference) = (base.clone(), base);

@@ -51,7 +51,7 @@ fn main() -> Result<()> {
     let method = args[2].as_str();
     let cap: usize = args[3].parse().context("ITERATIONS is a whole number")?;
     let scenario = spec.load(&DataSource::Procedural)?.scenarios.remove(0);
-    let configs = harness::paths::workspace_root().join("configs/methods.toml");
+    let configs = harness::paths::project_root()?.join("configs/methods.toml");
     let config: toml::Table = std::fs::read_to_string(&configs)?.parse()?;
     let mut params = config.get(method).and_then(toml::Value::as_table).cloned().unwrap_or_default();
     params.insert("max_iterations".into(), (cap as i64).into());

@@ -108,7 +108,7 @@ enum Command {
         a: PathBuf,
         /// The run judged against A.
         b: PathBuf,
-        /// Where compare.md and compare.html go [default: reports/comparison in the workspace].
+        /// Where compare.md and compare.html go [default: ./reports/comparison].
         #[arg(long)]
         out: Option<PathBuf>,
         /// Exit non-zero when some case is slower (exit 4) or worse in quality (exit 3).
@@ -121,6 +121,11 @@ enum Command {
     },
     /// List the registered methods and the scenarios.
     List(Common),
+    /// The configuration built into this binary (used where there is no ./configs).
+    Configs {
+        #[command(subcommand)]
+        command: ConfigsCommand,
+    },
     /// Results across commits: record runs into the history store, run commits, show the
     /// timelines with their steps, bisect a step (README, "Results across commits").
     History {
@@ -138,6 +143,17 @@ enum Command {
         /// The Python for `${DEFORMBENCH_PYTHON}` [env: DEFORMBENCH_PYTHON].
         #[arg(long)]
         python: Option<PathBuf>,
+    },
+}
+
+#[derive(Subcommand)]
+enum ConfigsCommand {
+    /// Write the built-in project files into DIR (created if missing): configs/, the committed
+    /// baselines (reports/baselines/), the Python scripts (python/, external/). Run `harness` from
+    /// DIR afterwards to use them as edited. Overwrites nothing: a file already there is an error.
+    Export {
+        /// The directory to write into.
+        dir: PathBuf,
     },
 }
 
@@ -214,8 +230,9 @@ impl Peers {
 
 #[derive(Args, Clone)]
 struct Gate {
-    /// The regression baseline [default: reports/baselines/survey.json in the workspace for a run on
-    /// the survey data, reports/baselines/procedural.json for one on the procedural look-alikes].
+    /// The regression baseline [default: the committed reports/baselines/survey.json beside the
+    /// configuration (./ or built in) for a run on the survey data, procedural.json for one on the
+    /// procedural look-alikes].
     #[arg(long)]
     baseline: Option<PathBuf>,
 }
@@ -226,7 +243,9 @@ struct Common {
     /// procedural look-alikes are used, and every report says so.
     #[arg(long)]
     survey_dir: Option<PathBuf>,
-    /// Configuration directory (methods.toml, verdicts.toml, scenarios/).
+    /// Configuration directory (methods.toml, verdicts.toml, scenarios/) [default: ./configs when it
+    /// holds methods.toml, else the configuration built into this binary; `configs export DIR`
+    /// writes that out].
     #[arg(long)]
     configs: Option<PathBuf>,
     /// A method file of your own, in the methods.toml format (paths relative to it), added on top
@@ -237,7 +256,7 @@ struct Common {
     /// configs/real-meshes for the real-mesh suite.
     #[arg(long)]
     scenarios: Option<PathBuf>,
-    /// Output directory.
+    /// Output directory [default: ./reports].
     #[arg(long)]
     reports: Option<PathBuf>,
     /// Hide the progress bar.
@@ -280,12 +299,26 @@ impl Meshes {
 }
 
 impl Common {
-    fn options(&self, scenarios: Vec<String>, methods: Vec<String>, command_line: &[String]) -> SuiteOptions {
-        let root = crate::paths::workspace_root();
-        SuiteOptions {
-            configs_dir: self.configs.clone().unwrap_or_else(|| root.join("configs")),
+    fn options(
+        &self,
+        scenarios: Vec<String>,
+        methods: Vec<String>,
+        command_line: &[String],
+    ) -> anyhow::Result<SuiteOptions> {
+        let configs_dir = match &self.configs {
+            Some(dir) => dir.clone(),
+            None => {
+                let project = crate::paths::project_files()?;
+                if let crate::paths::ProjectFiles::BuiltIn(_) = project {
+                    eprintln!("note: {}", project.describe());
+                }
+                project.root().join("configs")
+            }
+        };
+        Ok(SuiteOptions {
+            configs_dir,
             scenarios_dir: self.scenarios.clone(),
-            reports_dir: self.reports.clone().unwrap_or_else(|| root.join("reports")),
+            reports_dir: self.reports.clone().unwrap_or_else(crate::paths::default_reports_dir),
             survey_dir: self.survey_dir.clone().or_else(|| path_from_env(SURVEY_DIR_ENV)),
             scenarios,
             methods,
@@ -306,7 +339,7 @@ impl Common {
             command_line: command_line.to_vec(),
             repetitions: self.repeat as usize,
             progress: !self.quiet,
-        }
+        })
     }
 }
 
@@ -342,7 +375,7 @@ where
     let cli = Cli::parse_from(args);
     match cli.command {
         Command::All { common, peers, meshes, gate, no_check, shard } => {
-            let mut options = common.options(Vec::new(), Vec::new(), &command_line);
+            let mut options = common.options(Vec::new(), Vec::new(), &command_line)?;
             options.python = peers.python_path();
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
@@ -361,7 +394,7 @@ where
             publish_and_print(&staged_options, staging, run, &publish, gate)
         }
         Command::Merge { partials, common, meshes, gate, sweeps } => {
-            let mut options = common.options(Vec::new(), Vec::new(), &command_line);
+            let mut options = common.options(Vec::new(), Vec::new(), &command_line)?;
             options.sweeps = sweeps.then(|| options.configs_dir.join("sweeps.toml"));
             let (staging, staged_options) = staged(&options)?;
             let run = suite::merge(&staged_options, &partials).context("merging partial reports")?;
@@ -370,7 +403,7 @@ where
             publish_and_print(&staged_options, staging, run, &publish, gate)
         }
         Command::Run { methods, scenario, common, peers, meshes } => {
-            let mut options = common.options(vec![scenario], methods, &command_line);
+            let mut options = common.options(vec![scenario], methods, &command_line)?;
             options.python = peers.python_path();
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
@@ -387,14 +420,14 @@ where
             )
         }
         Command::Check { common, gate } => {
-            let dir = common.options(Vec::new(), Vec::new(), &command_line).reports_dir;
+            let dir = common.options(Vec::new(), Vec::new(), &command_line)?.reports_dir;
             match pipeline::check(&dir, gate.baseline.as_deref())? {
                 GateOutcome::Checked { baseline, findings } => Ok(print_findings(&findings, &baseline)),
                 GateOutcome::NotChecked(reason) => anyhow::bail!("{reason}"),
             }
         }
         Command::Baseline { common, gate } => {
-            let dir = common.options(Vec::new(), Vec::new(), &command_line).reports_dir;
+            let dir = common.options(Vec::new(), Vec::new(), &command_line)?.reports_dir;
             let (path, cases) = pipeline::write_baseline(&dir, gate.baseline.as_deref())?;
             println!("baseline: {cases} cases from {} written to {}", dir.display(), path.display());
             Ok(ExitCode::SUCCESS)
@@ -406,7 +439,7 @@ where
             );
             let (a, b) = (ComparedRun::read(&a)?, ComparedRun::read(&b)?);
             let comparison = crate::comparison::compare(&a, &b, min_change);
-            let out = out.unwrap_or_else(|| crate::paths::workspace_root().join("reports/comparison"));
+            let out = out.unwrap_or_else(|| crate::paths::current_dir_join("reports/comparison"));
             crate::report::write_comparison(&out, &comparison)
                 .with_context(|| format!("writing the comparison to {}", out.display()))?;
             // The warnings head the printed markdown.
@@ -424,7 +457,7 @@ where
             Ok(ExitCode::SUCCESS)
         }
         Command::CheckMethod { name, common, python } => {
-            let mut options = common.options(Vec::new(), Vec::new(), &command_line);
+            let mut options = common.options(Vec::new(), Vec::new(), &command_line)?;
             if python.is_some() {
                 options.python = python;
             }
@@ -450,8 +483,18 @@ where
             }
         }
         Command::History { command } => history::run(command),
+        Command::Configs { command: ConfigsCommand::Export { dir } } => {
+            let written = crate::paths::export_built_in(&dir)?;
+            println!(
+                "{} files written to {} (configs/, reports/baselines/, python/, external/); run harness from there \
+                 to use them",
+                written.len(),
+                dir.display()
+            );
+            Ok(ExitCode::SUCCESS)
+        }
         Command::List(common) => {
-            let options = common.options(Vec::new(), Vec::new(), &command_line);
+            let options = common.options(Vec::new(), Vec::new(), &command_line)?;
             println!("methods ({}):", options.configs_dir.join("methods.toml").display());
             let catalog = suite::load_catalog(&options)?;
             for m in catalog.methods() {

@@ -28,7 +28,10 @@ impl GateRequest {
     /// real-mesh suite `configs/real-meshes` or the dataset's smoke set `configs/dataset-smoke`);
     /// any other run is compared only with a baseline named on purpose.
     pub fn for_suite(options: &SuiteOptions, baseline: Option<PathBuf>) -> GateRequest {
-        let default_configs = crate::paths::workspace_root().join("configs");
+        let default_configs = match crate::paths::project_root() {
+            Ok(root) => root.join("configs"),
+            Err(e) => return GateRequest::Skip(format!("no project files to compare with: {e}")),
+        };
         let same = |a: &Path, b: &Path| {
             a.canonicalize().ok().zip(b.canonicalize().ok()).is_some_and(|(a, b)| a == b)
         };
@@ -52,11 +55,12 @@ impl GateRequest {
 }
 
 /// The baseline file `results` are compared with: `baseline` if given, else the committed baseline
-/// of their data source.
-pub fn baseline_path(baseline: Option<&Path>, results: &[CaseResult]) -> PathBuf {
-    baseline
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| BaselineKind::of(results).default_path(&crate::paths::workspace_root()))
+/// of their data source among the project files ([`crate::paths::project_files`]).
+pub fn baseline_path(baseline: Option<&Path>, results: &[CaseResult]) -> Result<PathBuf, HarnessError> {
+    match baseline {
+        Some(path) => Ok(path.to_path_buf()),
+        None => Ok(BaselineKind::of(results).default_path(&crate::paths::project_root()?)),
+    }
 }
 
 /// The work of a run after its cases, in the order [`publish`] does it; each is timed as a phase of
@@ -200,7 +204,7 @@ pub fn publish(
     let start = Instant::now();
     let outcome = match gate {
         GateRequest::Compare(baseline) => {
-            regression::gate(&baseline_path(baseline.as_deref(), &run.results), &run.results)?
+            regression::gate(&baseline_path(baseline.as_deref(), &run.results)?, &run.results)?
         }
         GateRequest::Skip(reason) => GateOutcome::NotChecked(reason),
     };
@@ -253,7 +257,7 @@ pub fn publish_partial(options: &SuiteOptions, run: &SuiteRun, shard: Shard) -> 
 pub fn check(reports_dir: &Path, baseline: Option<&Path>) -> Result<GateOutcome, HarnessError> {
     let results_path = reports_dir.join("results.json");
     let results = crate::stored_report::read_results(&results_path)?.cases;
-    let path = baseline_path(baseline, &results);
+    let path = baseline_path(baseline, &results)?;
     if !path.is_file() {
         return Err(HarnessError::Config { path, message: "no such baseline".into() });
     }
@@ -268,7 +272,7 @@ pub fn check(reports_dir: &Path, baseline: Option<&Path>) -> Result<GateOutcome,
 pub fn write_baseline(reports_dir: &Path, baseline: Option<&Path>) -> Result<(PathBuf, usize), HarnessError> {
     let results = crate::stored_report::read_results(&reports_dir.join("results.json"))?.cases;
     let new = regression::baseline_from(&results);
-    let path = baseline_path(baseline, &results);
+    let path = baseline_path(baseline, &results)?;
     regression::write_baseline(&path, &new)?;
     Ok((path, new.cases.len()))
 }

@@ -146,7 +146,10 @@ impl Machine {
 
 impl Build {
     fn read() -> Self {
-        let root = crate::paths::workspace_root();
+        // The checkout this binary was compiled from: the build is what the record describes, not
+        // the directory the run was started in. Read at run time, so a checkout that moved on since
+        // the build records its new HEAD (the binary is then stale); one that is gone records none.
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
         let git = |args: &[&str]| {
             std::process::Command::new("git")
                 .arg("-C")

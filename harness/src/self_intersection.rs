@@ -14,9 +14,9 @@ use crate::scenario::LoadedScenario;
 /// 400K-face bar of the `bar-sweep-200k` scenario without finishing.
 pub const MAX_FACES: usize = 100_000;
 
-/// The check's script, in the workspace.
-fn script() -> PathBuf {
-    crate::paths::python_dir().join("self_intersection.py")
+/// The check's script, among the project files ([`crate::paths::project_files`]).
+fn script() -> Result<PathBuf, HarnessError> {
+    Ok(crate::paths::python_dir()?.join("self_intersection.py"))
 }
 
 /// `is_self_intersecting` of every case of `results` that has a result with at most [`MAX_FACES`]
@@ -28,6 +28,7 @@ pub fn self_intersections(
 ) -> Result<Vec<Option<bool>>, HarnessError> {
     let dir = std::env::temp_dir().join(format!("deformbench-self-intersection-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|error| HarnessError::Io { path: dir.clone(), error })?;
+    let script = script()?;
     let outcome = (|| {
         let mut files: Vec<(usize, PathBuf)> = Vec::new();
         for (i, r) in results.iter().enumerate() {
@@ -54,7 +55,7 @@ pub fn self_intersections(
             .filter(|h| !h.is_empty())
             .map(|half| {
                 Command::new(python)
-                    .arg(script())
+                    .arg(&script)
                     .args(half.iter())
                     .stdout(std::process::Stdio::piped())
                     .stderr(std::process::Stdio::piped())
@@ -70,7 +71,7 @@ pub fn self_intersections(
             if !out.status.success() {
                 return Err(HarnessError::Report(format!(
                     "{} failed: {}",
-                    script().display(),
+                    script.display(),
                     String::from_utf8_lossy(&out.stderr).trim()
                 )));
             }
@@ -84,7 +85,7 @@ pub fn self_intersections(
         if let Some((i, _)) = files.iter().find(|(i, _)| answers[*i].is_none()) {
             return Err(HarnessError::Report(format!(
                 "{}: no self-intersection answer for {} / {}",
-                script().display(),
+                script.display(),
                 results[*i].scenario,
                 results[*i].method
             )));

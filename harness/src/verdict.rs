@@ -541,7 +541,7 @@ mod tests {
 
     #[test]
     fn the_committed_rules_load_and_bad_values_are_named() {
-        let committed = crate::paths::workspace_root().join("configs/verdicts.toml");
+        let committed = crate::paths::tests::checkout_root().join("configs/verdicts.toml");
         let r = VerdictRules::load(&committed).unwrap();
         assert_eq!(r.max_folds, 0.0, "any fold is suspect (issue 14)");
         let dir = tempfile::tempdir().unwrap();

@@ -123,7 +123,7 @@ pub(super) struct SuiteArgs {
 
 impl SuiteArgs {
     fn options(&self, store: &std::path::Path) -> anyhow::Result<CollectOptions> {
-        let repo = git::repository_root(&crate::paths::workspace_root())?;
+        let repo = git::repository_root(&crate::paths::current_dir_join("."))?;
         let mut suite_args = vec![
             "--threads".to_string(),
             self.threads.to_string(),
@@ -211,7 +211,7 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
         }
         HistoryCommand::Forget { commits, store } => {
             let path = store.path();
-            let repo = git::repository_root(&crate::paths::workspace_root())?;
+            let repo = git::repository_root(&crate::paths::current_dir_join("."))?;
             let mut history = HistoryStore::open_existing(&path)?;
             for c in &commits {
                 let sha = git::resolve(&repo, c).unwrap_or_else(|_| c.clone());
@@ -222,7 +222,7 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
         HistoryCommand::Show { store, out, repo } => {
             let path = store.path();
             let history_store = HistoryStore::open_existing(&path)?;
-            let repo = git::repository_root(&repo.unwrap_or_else(crate::paths::workspace_root))?;
+            let repo = git::repository_root(&repo.unwrap_or_else(|| crate::paths::current_dir_join(".")))?;
             let built = timeline::build(&history_store, &repo)?;
             let out = out.unwrap_or_else(|| path.parent().unwrap_or(std::path::Path::new(".")).join("page"));
             let index = page::write_page(&out, &built, &path)?;

@@ -17,9 +17,9 @@ pub mod timeline;
 use std::path::PathBuf;
 
 /// Where the store lives unless `--store` or [`STORE_ENV`] says otherwise: `history/` in the
-/// workspace (not reports/, which a run replaces whole).
+/// current directory (not reports/, which a run replaces whole).
 pub fn default_store() -> PathBuf {
-    crate::paths::workspace_root().join("history/history.sqlite")
+    crate::paths::current_dir_join("history/history.sqlite")
 }
 
 /// Environment variable naming the store.
