@@ -3,13 +3,13 @@
 //! Nothing is found through the directory the binary was built in (issue 60): a run reads the
 //! configuration of `--configs`, else `./configs` of the current directory (a checkout, or a
 //! directory written by `harness configs export`), else the copy compiled into the binary (written
-//! to a temporary directory for the process and removed at its end); outputs default to the current
-//! directory (`./reports`, `./history/history.sqlite`). The project files are the configuration
+//! once per build to the user's cache, [`cache_dir`]); outputs default to the current directory
+//! (`./reports`, `./history/history.sqlite`). The project files are the configuration
 //! (`configs/`), the committed regression baselines (`reports/baselines/`) and the Python scripts
 //! the harness and the peers run (`python/`, `external/`), kept in their checkout layout.
 
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, OnceLock};
+use std::sync::OnceLock;
 
 use crate::error::HarnessError;
 
@@ -39,7 +39,7 @@ pub fn built_in_files() -> &'static [(&'static str, &'static [u8])] {
 pub enum ProjectFiles {
     /// A directory with `configs/methods.toml` (the current directory when it has one).
     Directory(PathBuf),
-    /// The copy compiled into the binary, written out to this temporary directory.
+    /// The copy compiled into the binary, written out to this directory ([`cache_dir`]).
     BuiltIn(PathBuf),
 }
 
@@ -108,27 +108,65 @@ pub fn current_dir_join(relative: impl AsRef<Path>) -> PathBuf {
     }
 }
 
-/// The temporary directory holding the built-in copy, removed by [`remove_built_in_copy`].
-static BUILT_IN_COPY: Mutex<Option<tempfile::TempDir>> = Mutex::new(None);
-
-/// Write the built-in project files to a fresh temporary directory and return it.
+/// Write the built-in project files to the user's cache (once per content: see [`cache_dir`]) and
+/// return that directory. A copy whose files differ from the built-in ones (edited, or cut short by a
+/// killed process) is written again; a new copy is written beside it and renamed into place, so
+/// concurrent runs see a whole copy or none.
 fn materialize_built_in() -> Result<PathBuf, HarnessError> {
-    let dir = tempfile::Builder::new()
-        .prefix("deformbench-project-")
-        .tempdir()
-        .map_err(|e| HarnessError::Io { path: std::env::temp_dir(), error: e })?;
-    write_built_in(dir.path())?;
-    let root = dir.path().to_path_buf();
-    *BUILT_IN_COPY.lock().unwrap_or_else(|e| e.into_inner()) = Some(dir);
-    Ok(root)
+    let dir = cache_dir();
+    if copy_is_whole(&dir) {
+        return Ok(dir);
+    }
+    let parent = dir.parent().unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).map_err(|e| HarnessError::Io { path: parent.to_path_buf(), error: e })?;
+    let staging = tempfile::Builder::new()
+        .prefix(".staging-")
+        .tempdir_in(parent)
+        .map_err(|e| HarnessError::Io { path: parent.to_path_buf(), error: e })?;
+    write_built_in(staging.path())?;
+    if dir.exists() && !copy_is_whole(&dir) {
+        // A damaged copy: replaced whole.
+        std::fs::remove_dir_all(&dir).map_err(|e| HarnessError::Io { path: dir.clone(), error: e })?;
+    }
+    match std::fs::rename(staging.path(), &dir) {
+        Ok(()) => {
+            let _ = staging.keep();
+            Ok(dir)
+        }
+        // Another run put its whole copy there first.
+        Err(_) if copy_is_whole(&dir) => Ok(dir),
+        Err(e) => Err(HarnessError::Io { path: dir, error: e }),
+    }
 }
 
-/// Remove the temporary copy of the built-in project files, if one was written (the CLI calls this
-/// before it exits).
-pub fn remove_built_in_copy() {
-    if let Some(dir) = BUILT_IN_COPY.lock().unwrap_or_else(|e| e.into_inner()).take() {
-        let _ = dir.close();
+/// Where the built-in project files are written out: `deformbench/project-<version>-<hash>` in
+/// `$XDG_CACHE_HOME`, else `~/.cache`, else the temporary directory; the hash is of the files, so
+/// each build writes its own copy once and runs reuse it (nothing accumulates, and a killed run
+/// leaves nothing behind).
+pub fn cache_dir() -> PathBuf {
+    use sha2::{Digest, Sha256};
+    let mut hash = Sha256::new();
+    for (relative, contents) in built_in_files() {
+        hash.update(relative.as_bytes());
+        hash.update((contents.len() as u64).to_le_bytes());
+        hash.update(contents);
     }
+    let hex: String = hash.finalize().iter().take(8).map(|b| format!("{b:02x}")).collect();
+    let base = std::env::var_os("XDG_CACHE_HOME")
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| {
+            std::env::var_os("HOME").filter(|v| !v.is_empty()).map(|h| PathBuf::from(h).join(".cache"))
+        })
+        .unwrap_or_else(std::env::temp_dir);
+    base.join("deformbench").join(format!("project-{}-{hex}", env!("CARGO_PKG_VERSION")))
+}
+
+/// Does `dir` hold every built-in file with its built-in contents?
+fn copy_is_whole(dir: &Path) -> bool {
+    built_in_files()
+        .iter()
+        .all(|(relative, contents)| std::fs::read(dir.join(relative)).is_ok_and(|b| b == *contents))
 }
 
 /// Write every built-in project file under `root` in the checkout layout. Returns how many.

@@ -1,6 +1,6 @@
 //! Issue 60: the harness works as an installed tool. Run from an empty directory it reads the
-//! configuration built into the binary, writes `./reports` there and nothing in the checkout it was
-//! built from, and leaves no temporary copy behind; `configs export` writes the configuration out and
+//! configuration built into the binary (one copy in the user's cache), writes `./reports` there and
+//! nothing in the checkout it was built from; `configs export` writes the configuration out and
 //! a run from there reads it.
 
 use std::path::{Path, PathBuf};
@@ -12,14 +12,16 @@ fn checkout() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..").canonicalize().unwrap()
 }
 
-/// `harness ARGS` with the working directory `cwd` and its own empty `TMPDIR` (returned, to see that
-/// the run leaves nothing there); no survey data or method files from the environment.
-fn harness_in(cwd: &Path, args: &[&str]) -> (Output, tempfile::TempDir) {
+/// `harness ARGS` with the working directory `cwd`, the cache `cache` (`XDG_CACHE_HOME`) and an
+/// empty `TMPDIR` of its own (returned, to see that the run leaves nothing there); no survey data
+/// or method files from the environment.
+fn harness_in(cwd: &Path, cache: &Path, args: &[&str]) -> (Output, tempfile::TempDir) {
     let tmp = tempfile::tempdir().unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_harness"))
         .args(args)
         .current_dir(cwd)
         .env("TMPDIR", tmp.path())
+        .env("XDG_CACHE_HOME", cache)
         .env_remove("DEFORM_SURVEY_DIR")
         .env_remove("DEFORMBENCH_METHODS")
         .env_remove("DEFORMBENCH_HISTORY")
@@ -63,9 +65,9 @@ fn a_run_from_an_empty_directory_writes_only_there() {
     let checkout = checkout();
     let (status_before, mtimes_before) = (git_status(&checkout), mtimes(&checkout.join("reports")));
     let configs_before = mtimes(&checkout.join("configs"));
-    let empty = tempfile::tempdir().unwrap();
-    let (out, tmp) =
-        harness_in(empty.path(), &["run", "--scenario", "bar", "--method", "laplacian", "--quiet"]);
+    let (empty, cache) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let bar = ["run", "--scenario", "bar", "--method", "laplacian", "--quiet"];
+    let (out, tmp) = harness_in(empty.path(), cache.path(), &bar);
     let stderr = text(&out.stderr);
     assert!(out.status.success(), "exit {:?}\n{stderr}\n{}", out.status, text(&out.stdout));
     assert!(
@@ -79,11 +81,27 @@ fn a_run_from_an_empty_directory_writes_only_there() {
     let results: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(reports.join("results.json")).unwrap()).unwrap();
     assert_eq!(results["cases"][0]["mesh_source"], "procedural look-alike");
-    // Only ./reports appeared where the run started; the temporary copy of the configuration is gone.
+    // Only ./reports appeared where the run started, nothing in TMPDIR, and one copy of the built-in
+    // configuration in the cache, which a second run reuses.
     let here: Vec<_> = std::fs::read_dir(empty.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
     assert_eq!(here, vec![std::ffi::OsString::from("reports")]);
     let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().map(|e| e.unwrap().path()).collect();
     assert!(left.is_empty(), "left in TMPDIR: {left:?}");
+    let copies = || -> Vec<PathBuf> {
+        std::fs::read_dir(cache.path().join("deformbench")).unwrap().map(|e| e.unwrap().path()).collect()
+    };
+    let first = copies();
+    assert_eq!(first.len(), 1, "{first:?}");
+    // An edited copy is written again before it is used.
+    let methods = first[0].join("configs/methods.toml");
+    std::fs::write(&methods, "not toml [").unwrap();
+    let (again, _tmp) = harness_in(empty.path(), cache.path(), &bar);
+    assert!(again.status.success(), "{}", text(&again.stderr));
+    assert_eq!(copies(), first);
+    assert_eq!(
+        std::fs::read(&methods).unwrap(),
+        std::fs::read(checkout.join("configs/methods.toml")).unwrap()
+    );
     // The checkout it was built from is untouched.
     assert_eq!(git_status(&checkout), status_before, "git status of {} changed", checkout.display());
     assert_eq!(mtimes(&checkout.join("reports")), mtimes_before, "the checkout's reports/ was written");
@@ -92,12 +110,12 @@ fn a_run_from_an_empty_directory_writes_only_there() {
 
 #[test]
 fn list_and_export_work_without_a_checkout_and_an_exported_configuration_is_read() {
-    let empty = tempfile::tempdir().unwrap();
-    let (out, _tmp) = harness_in(empty.path(), &["list"]);
+    let (empty, cache) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let (out, _tmp) = harness_in(empty.path(), cache.path(), &["list"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(text(&out.stdout).contains("arap"), "{}", text(&out.stdout));
 
-    let (out, _tmp) = harness_in(empty.path(), &["configs", "export", "mine"]);
+    let (out, _tmp) = harness_in(empty.path(), cache.path(), &["configs", "export", "mine"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let mine = empty.path().join("mine");
     for file in [
@@ -114,12 +132,12 @@ fn list_and_export_work_without_a_checkout_and_an_exported_configuration_is_read
         );
     }
     // Exporting again overwrites nothing and says which file is in the way (exit 2).
-    let (again, _tmp) = harness_in(empty.path(), &["configs", "export", "mine"]);
+    let (again, _tmp) = harness_in(empty.path(), cache.path(), &["configs", "export", "mine"]);
     assert_eq!(again.status.code(), Some(2));
     assert!(text(&again.stderr).contains("exists already"), "{}", text(&again.stderr));
 
     // From the exported directory its ./configs is read (`list` names the file it read).
-    let (out, _tmp) = harness_in(&mine, &["list"]);
+    let (out, _tmp) = harness_in(&mine, cache.path(), &["list"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(!text(&out.stderr).contains("built into"), "{}", text(&out.stderr));
     assert!(
