@@ -50,6 +50,10 @@ pub(super) enum HistoryCommand {
         commits: Vec<String>,
         #[command(flatten)]
         store: StoreArgs,
+        /// The git checkout the commits are named in [default: the repository of the current
+        /// directory].
+        #[arg(long)]
+        repo: Option<PathBuf>,
     },
     /// Write the history page: timelines per scenario × method (PNG), steps named with commits.
     Show {
@@ -58,7 +62,8 @@ pub(super) enum HistoryCommand {
         /// Where index.html, steps.md and plots/ go [default: history/page next to the store].
         #[arg(long)]
         out: Option<PathBuf>,
-        /// The git checkout whose history orders the commits [default: this workspace's].
+        /// The git checkout whose history orders the commits [default: the repository of the current
+        /// directory].
         #[arg(long)]
         repo: Option<PathBuf>,
     },
@@ -80,8 +85,8 @@ pub(super) enum HistoryCommand {
 
 #[derive(Args, Clone)]
 pub(super) struct StoreArgs {
-    /// The history store [env: DEFORMBENCH_HISTORY; default: history/history.sqlite in the
-    /// workspace].
+    /// The history store [env: DEFORMBENCH_HISTORY] [default: ./history/history.sqlite, relative to
+    /// the current directory].
     #[arg(long)]
     store: Option<PathBuf>,
 }
@@ -113,6 +118,9 @@ pub(super) struct SuiteArgs {
     /// Worktree, build and logs [default: history/work next to the store].
     #[arg(long)]
     work_dir: Option<PathBuf>,
+    /// The git checkout whose commits are run [default: the repository of the current directory].
+    #[arg(long)]
+    repo: Option<PathBuf>,
     /// Retry commits that failed to build or run before.
     #[arg(long)]
     retry_failed: bool,
@@ -123,7 +131,7 @@ pub(super) struct SuiteArgs {
 
 impl SuiteArgs {
     fn options(&self, store: &std::path::Path) -> anyhow::Result<CollectOptions> {
-        let repo = git::repository_root(&crate::paths::workspace_root())?;
+        let repo = history::repository(self.repo.as_deref())?;
         let mut suite_args = vec![
             "--threads".to_string(),
             self.threads.to_string(),
@@ -209,9 +217,9 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
             println!("store: {}", path.display());
             Ok(if failed > 0 { ExitCode::from(super::EXIT_CASE_FAILED) } else { ExitCode::SUCCESS })
         }
-        HistoryCommand::Forget { commits, store } => {
+        HistoryCommand::Forget { commits, store, repo } => {
             let path = store.path();
-            let repo = git::repository_root(&crate::paths::workspace_root())?;
+            let repo = history::repository(repo.as_deref())?;
             let mut history = HistoryStore::open_existing(&path)?;
             for c in &commits {
                 let sha = git::resolve(&repo, c).unwrap_or_else(|_| c.clone());
@@ -222,7 +230,7 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
         HistoryCommand::Show { store, out, repo } => {
             let path = store.path();
             let history_store = HistoryStore::open_existing(&path)?;
-            let repo = git::repository_root(&repo.unwrap_or_else(crate::paths::workspace_root))?;
+            let repo = history::repository(repo.as_deref())?;
             let built = timeline::build(&history_store, &repo)?;
             let out = out.unwrap_or_else(|| path.parent().unwrap_or(std::path::Path::new(".")).join("page"));
             let index = page::write_page(&out, &built, &path)?;

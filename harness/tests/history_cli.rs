@@ -1,0 +1,131 @@
+//! `harness history` and `harness compare` through the `harness` binary (issue 60): exit codes,
+//! the messages of refused arguments, where the store and the repository are found by default, that
+//! a refused call writes nothing, runs of uncommitted changes as points of their own, and `compare`
+//! of two runs of one commit.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Run the harness in `cwd` with `args` (no DEFORMBENCH_HISTORY from the caller's environment):
+/// exit code and stdout + stderr.
+fn harness_in(cwd: &Path, args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_harness"))
+        .args(args)
+        .current_dir(cwd)
+        .env_remove("DEFORMBENCH_HISTORY")
+        .env_remove("DEFORM_SURVEY_DIR")
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    (out.status.code().unwrap_or(-1), text)
+}
+
+fn git(repo: &Path, args: &[&str]) -> String {
+    let out = Command::new("git")
+        .arg("-C")
+        .arg(repo)
+        .args(["-c", "user.name=t", "-c", "user.email=t@t", "-c", "commit.gpgsign=false"])
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "git {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout).trim().to_string()
+}
+
+/// A repository of `n` commits (each changing `note.txt`); their hashes, oldest first.
+fn repository(dir: &Path, n: usize) -> Vec<String> {
+    std::fs::create_dir_all(dir).unwrap();
+    git(dir, &["init", "--quiet", "-b", "main"]);
+    (0..n)
+        .map(|i| {
+            std::fs::write(dir.join("note.txt"), format!("{i}\n")).unwrap();
+            git(dir, &["add", "-A"]);
+            git(dir, &["commit", "--quiet", "-m", &format!("commit {i}")]);
+            git(dir, &["rev-parse", "HEAD"])
+        })
+        .collect()
+}
+
+/// How a synthetic run was made.
+struct Run<'a> {
+    commit: &'a str,
+    cpu: &'a str,
+    /// `None`: a clean tree; `Some(hash)`: dirty, with that diff hash (`Some("")`: dirty, no hash
+    /// recorded, as harness versions before issue 60 wrote).
+    diff: Option<&'a str>,
+    e_theta: f64,
+}
+
+impl<'a> Run<'a> {
+    fn clean(commit: &'a str) -> Self {
+        Run { commit, cpu: "Test CPU", diff: None, e_theta: 1.0 }
+    }
+}
+
+/// A results.json of bar / arap as `harness all --repeat 3` writes it.
+fn results_json(run: &Run) -> String {
+    let build = match run.diff {
+        None => format!(r#""git_commit":"{}","git_dirty":false"#, run.commit),
+        Some("") => format!(r#""git_commit":"{}","git_dirty":true"#, run.commit),
+        Some(h) => format!(r#""git_commit":"{}","git_dirty":true,"git_diff_sha256":"{h}""#, run.commit),
+    };
+    format!(
+        r#"{{"data_source":"survey","provenance":{{"machine":{{"cpu_model":"{cpu}","logical_cores":2,"memory_gib":8}},
+        "build":{{{build}}},"run":{{"started_utc":"2026-12-06T00:00:00Z","threads":2,"jobs":1,"repetitions":3}},
+        "inputs":[{{"path":"/data/bar.off","sha256":"ab"}}]}},
+        "cases":[{{"scenario":"bar","method":"arap","status":"ok","bind_s":0.0,"solve_s":2.0,"precompute_s":0.1,"iterations":40,
+        "peak_memory_mib":10.0,"e_theta_deg":{e_theta},"steps":[{{}}],
+        "spread":{{"bind_s":{{"min":0.0,"max":0.0}},"solve_s":{{"min":1.96,"max":2.04}},"precompute_s":{{"min":0.1,"max":0.1}}}}}}]}}"#,
+        cpu = run.cpu,
+        e_theta = run.e_theta,
+    )
+}
+
+fn write_run(dir: &Path, name: &str, run: &Run) -> PathBuf {
+    let file = dir.join(name);
+    std::fs::write(&file, results_json(run)).unwrap();
+    file
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Item 6: the store defaults to ./history/history.sqlite under the current directory (and
+/// `--help` says so); `show` outside a git repository says so and names `--repo`.
+#[test]
+fn history_defaults_to_the_current_directory_and_its_repository() {
+    let dir = tempfile::tempdir().unwrap();
+    let cwd = dir.path().join("elsewhere");
+    std::fs::create_dir(&cwd).unwrap();
+    let run = write_run(dir.path(), "run.json", &Run::clean("abc"));
+    let (code, text) = harness_in(&cwd, &["history", "record", s(&run)]);
+    assert_eq!(code, 0, "{text}");
+    assert!(
+        cwd.join("history/history.sqlite").is_file(),
+        "the store is not under the current directory: {text}"
+    );
+
+    let (code, text) = harness_in(&cwd, &["history", "show"]);
+    assert_eq!(code, 2, "{text}");
+    assert!(
+        text.contains(s(&cwd)) && text.contains("not in a git repository") && text.contains("--repo"),
+        "{text}"
+    );
+    assert!(!cwd.join("history/page").exists(), "a refused show wrote its page");
+
+    let repo = dir.path().join("repo");
+    repository(&repo, 1);
+    let (code, text) = harness_in(&cwd, &["history", "show", "--repo", s(&repo)]);
+    assert_eq!(code, 0, "{text}");
+    assert!(cwd.join("history/page/index.html").is_file(), "{text}");
+
+    for command in ["record", "run", "show", "find", "forget"] {
+        let (code, text) = harness_in(&cwd, &["history", command, "--help"]);
+        assert_eq!(code, 0, "{text}");
+        assert!(text.contains("./history/history.sqlite"), "history {command} --help: {text}");
+        if command != "record" {
+            assert!(text.contains("--repo"), "history {command} --help: {text}");
+        }
+    }
+}
