@@ -129,3 +129,47 @@ fn history_defaults_to_the_current_directory_and_its_repository() {
         }
     }
 }
+
+/// The number of runs in the store, read with the library.
+fn stored_runs(store: &Path) -> usize {
+    harness::history::store::HistoryStore::open_existing(store).unwrap().runs().unwrap().len()
+}
+
+/// Item 1: forgetting a commit the store holds no runs of is an error naming it (exit 2), whether
+/// git knows it or not, and removes nothing, not even the runs of the other commits named.
+#[test]
+fn forgetting_a_commit_without_runs_is_an_error_and_removes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let repo = dir.path().join("repo");
+    let commits = repository(&repo, 3);
+    let store = dir.path().join("h.sqlite");
+    let runs: Vec<PathBuf> = commits[..2]
+        .iter()
+        .enumerate()
+        .map(|(i, c)| write_run(dir.path(), &format!("run{i}.json"), &Run::clean(c)))
+        .collect();
+    let (code, text) =
+        harness_in(&repo, &["history", "record", "--store", s(&store), s(&runs[0]), s(&runs[1])]);
+    assert_eq!(code, 0, "{text}");
+    assert_eq!(stored_runs(&store), 2);
+
+    // Not a commit at all, alone and after a good one.
+    for args in [vec!["deadbeefcafe"], vec![&commits[0][..12], "deadbeefcafe"]] {
+        let mut all = vec!["history", "forget", "--store", s(&store)];
+        all.extend(args);
+        let (code, text) = harness_in(&repo, &all);
+        assert_eq!(code, 2, "{text}");
+        assert!(text.contains("deadbeefcafe") && text.contains("no runs of it are stored"), "{text}");
+        assert_eq!(stored_runs(&store), 2, "a refused forget removed runs: {text}");
+    }
+    // A commit of the repository that was never recorded.
+    let (code, text) = harness_in(&repo, &["history", "forget", "--store", s(&store), "HEAD"]);
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains("HEAD") && text.contains(&commits[2][..12]) && text.contains("no runs"), "{text}");
+    assert_eq!(stored_runs(&store), 2);
+    // Outside the repository a stored commit is found by its first digits.
+    let (code, text) = harness_in(dir.path(), &["history", "forget", "--store", s(&store), &commits[1][..8]]);
+    assert_eq!(code, 0, "{text}");
+    assert!(text.contains("1 run(s) removed"), "{text}");
+    assert_eq!(stored_runs(&store), 1);
+}

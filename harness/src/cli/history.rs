@@ -1,6 +1,7 @@
 //! `harness history`: record runs, fill the store from commits, show timelines, bisect a step.
 
-use std::path::PathBuf;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Args, Subcommand};
@@ -51,7 +52,7 @@ pub(super) enum HistoryCommand {
         #[command(flatten)]
         store: StoreArgs,
         /// The git checkout the commits are named in [default: the repository of the current
-        /// directory].
+        /// directory; without one, a commit is found by its hash's first digits among the stored].
         #[arg(long)]
         repo: Option<PathBuf>,
     },
@@ -178,6 +179,47 @@ fn print_outcome(label: &str, outcome: &Outcome) {
     }
 }
 
+/// The stored commit `name` means for `history forget`: git's reading of it in `repo`, else the one
+/// stored hash that begins with it; an error naming it when the store holds no runs (nor failures)
+/// of it.
+fn forget_target(
+    name: &str,
+    repo: Option<&Path>,
+    stored: &BTreeMap<String, (usize, usize)>,
+    store: &Path,
+) -> anyhow::Result<String> {
+    if let Some(sha) = repo.and_then(|r| git::resolve(r, name).ok()) {
+        anyhow::ensure!(
+            stored.contains_key(&sha),
+            "{name} ({}): no runs of it are stored in {}; nothing removed",
+            &sha[..sha.len().min(12)],
+            store.display()
+        );
+        return Ok(sha);
+    }
+    let prefix = name.to_ascii_lowercase();
+    let matches: Vec<&String> = if prefix.len() >= 4 && prefix.chars().all(|c| c.is_ascii_hexdigit()) {
+        stored.keys().filter(|k| k.starts_with(&prefix)).collect()
+    } else {
+        Vec::new()
+    };
+    match matches[..] {
+        [one] => Ok(one.clone()),
+        [] => anyhow::bail!(
+            "{name}: no runs of it are stored in {}{}; nothing removed",
+            store.display(),
+            match repo {
+                Some(r) => format!(", and it is not a commit of {}", r.display()),
+                None => " (and no git repository here to read it in; --repo names one)".to_string(),
+            }
+        ),
+        _ => anyhow::bail!(
+            "{name}: the hashes of {} stored commits begin with it; give more digits; nothing removed",
+            matches.len()
+        ),
+    }
+}
+
 pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
     match command {
         HistoryCommand::Record { reports, store, allow_mixed, allow_dirty } => {
@@ -219,11 +261,21 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
         }
         HistoryCommand::Forget { commits, store, repo } => {
             let path = store.path();
-            let repo = history::repository(repo.as_deref())?;
             let mut history = HistoryStore::open_existing(&path)?;
-            for c in &commits {
-                let sha = git::resolve(&repo, c).unwrap_or_else(|_| c.clone());
-                println!("{c}: {} run(s) removed", history.forget(&sha)?);
+            // Without a repository a commit is still found among the stored by its first digits.
+            let repo = match repo {
+                Some(dir) => Some(history::repository(Some(&dir))?),
+                None => history::repository(None).ok(),
+            };
+            let stored = history.stored_commits()?;
+            // Every name is resolved and checked first: one that names no stored commit removes
+            // nothing, not even the runs of the others.
+            let shas = commits
+                .iter()
+                .map(|c| forget_target(c, repo.as_deref(), &stored, &path))
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            for (c, n) in commits.iter().zip(history.forget_all(&shas)?) {
+                println!("{c}: {n} run(s) removed");
             }
             Ok(ExitCode::SUCCESS)
         }

@@ -407,16 +407,49 @@ impl HistoryStore {
     /// run spoiled by something outside it (a loaded machine), before running the commit again.
     /// Returns the runs removed.
     pub fn forget(&mut self, commit: &str) -> Result<usize, HistoryError> {
+        Ok(self.forget_all(&[commit.to_string()])?[0])
+    }
+
+    /// [`HistoryStore::forget`] of each of `commits`, in one transaction; the runs removed of each.
+    pub fn forget_all(&mut self, commits: &[String]) -> Result<Vec<usize>, HistoryError> {
         let path = self.path.clone();
         let sql = move |error| HistoryError::Sqlite { path: path.clone(), error };
         let tx = self.conn.transaction().map_err(&sql)?;
-        let runs = "SELECT id FROM runs WHERE git_commit = ?1";
-        tx.execute(&format!("DELETE FROM measurements WHERE run IN ({runs})"), [commit]).map_err(&sql)?;
-        tx.execute(&format!("DELETE FROM cases WHERE run IN ({runs})"), [commit]).map_err(&sql)?;
-        let removed = tx.execute("DELETE FROM runs WHERE git_commit = ?1", [commit]).map_err(&sql)?;
-        tx.execute("DELETE FROM failures WHERE git_commit = ?1", [commit]).map_err(&sql)?;
+        let mut removed = Vec::new();
+        for commit in commits {
+            let runs = "SELECT id FROM runs WHERE git_commit = ?1";
+            tx.execute(&format!("DELETE FROM measurements WHERE run IN ({runs})"), [commit]).map_err(&sql)?;
+            tx.execute(&format!("DELETE FROM cases WHERE run IN ({runs})"), [commit]).map_err(&sql)?;
+            removed.push(tx.execute("DELETE FROM runs WHERE git_commit = ?1", [commit]).map_err(&sql)?);
+            tx.execute("DELETE FROM failures WHERE git_commit = ?1", [commit]).map_err(&sql)?;
+        }
         tx.commit().map_err(&sql)?;
         Ok(removed)
+    }
+
+    /// Every commit the store holds runs or failures of: full hash -> (runs, failures).
+    pub fn stored_commits(&self) -> Result<BTreeMap<String, (usize, usize)>, HistoryError> {
+        let mut out: BTreeMap<String, (usize, usize)> = BTreeMap::new();
+        for (table, failures) in [("runs", false), ("failures", true)] {
+            let mut stmt = self
+                .conn
+                .prepare(&format!("SELECT git_commit, count(*) FROM {table} GROUP BY git_commit"))
+                .map_err(self.sql())?;
+            let rows = stmt
+                .query_map([], |r| Ok((r.get::<_, String>(0)?, r.get::<_, i64>(1)? as usize)))
+                .map_err(self.sql())?
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(self.sql())?;
+            for (commit, n) in rows {
+                let entry = out.entry(commit).or_default();
+                if failures {
+                    entry.1 = n;
+                } else {
+                    entry.0 = n;
+                }
+            }
+        }
+        Ok(out)
     }
 
     /// Keep that `commit` failed at `stage` for its request (replacing an earlier failure).
