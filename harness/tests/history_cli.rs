@@ -173,3 +173,49 @@ fn forgetting_a_commit_without_runs_is_an_error_and_removes_nothing() {
     assert!(text.contains("1 run(s) removed"), "{text}");
     assert_eq!(stored_runs(&store), 1);
 }
+
+/// Item 2: a store path that cannot be one names the path and the reason (exit 2), and nothing is
+/// written: a directory, a "directory" that is a file, a directory that cannot be made, a
+/// read-only directory (unless this process may write there anyway, as root may).
+#[test]
+fn a_store_path_that_cannot_be_one_says_why_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = write_run(dir.path(), "run.json", &Run::clean("abc"));
+    let record = |store: &Path| harness_in(dir.path(), &["history", "record", "--store", s(store), s(&run)]);
+
+    let a_dir = dir.path().join("a-dir");
+    std::fs::create_dir(&a_dir).unwrap();
+    let (code, text) = record(&a_dir);
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains(s(&a_dir)) && text.contains("is a directory"), "{text}");
+    assert_eq!(std::fs::read_dir(&a_dir).unwrap().count(), 0, "written into the directory");
+
+    let a_file = dir.path().join("a-file");
+    std::fs::write(&a_file, "text").unwrap();
+    let (code, text) = record(&a_file.join("h.sqlite"));
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains(s(&a_file)) && text.contains("is not a directory"), "{text}");
+    let (code, text) = record(&a_file.join("sub/h.sqlite"));
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains(&format!("cannot create directory {}/sub", s(&a_file))), "{text}");
+    assert!(text.to_lowercase().contains("not a directory"), "{text}");
+    assert_eq!(std::fs::read_to_string(&a_file).unwrap(), "text");
+
+    use std::os::unix::fs::PermissionsExt;
+    let read_only = dir.path().join("read-only");
+    std::fs::create_dir(&read_only).unwrap();
+    std::fs::set_permissions(&read_only, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let probe = read_only.join("probe");
+    if std::fs::write(&probe, "").is_ok() {
+        std::fs::remove_file(&probe).unwrap();
+        eprintln!("SKIPPED: the read-only directory case (this process may write anywhere)");
+    } else {
+        for store in [read_only.join("h.sqlite"), read_only.join("sub/h.sqlite")] {
+            let (code, text) = record(&store);
+            assert_eq!(code, 2, "{text}");
+            assert!(text.contains(s(&store)) && text.contains("permission denied"), "{text}");
+        }
+        assert_eq!(std::fs::read_dir(&read_only).unwrap().count(), 0, "written into the directory");
+    }
+    std::fs::set_permissions(&read_only, std::fs::Permissions::from_mode(0o755)).unwrap();
+}

@@ -57,6 +57,8 @@ pub const STORE_ENV: &str = "DEFORMBENCH_HISTORY";
 pub enum HistoryError {
     #[error("{}: not a usable history store: {detail}. It is left as it is: move it away, or give another --store", path.display())]
     Corrupt { path: PathBuf, detail: String },
+    #[error("{}: cannot be the history store: {reason}; nothing was written", path.display())]
+    Unusable { path: PathBuf, reason: String },
     #[error("{}: no history store here (`harness history record REPORTS` or `harness history run A..B` makes one)", path.display())]
     NoStore { path: PathBuf },
     #[error("{}: refused, this run would mix series: {}. Give --allow-mixed to keep it on timelines of its own", path.display(), conflicts.join("; "))]

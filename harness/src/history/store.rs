@@ -129,17 +129,58 @@ pub struct HistoryStore {
 }
 
 impl HistoryStore {
-    /// Open the store at `path`, creating it (and its directory) if there is none.
+    /// Open the store at `path`, creating it (and its directory) if there is none. A path that
+    /// cannot be a store (a directory, a directory that cannot be made, a file that cannot be
+    /// created or written) is an error naming it and the reason, and leaves nothing behind.
     pub fn open_or_create(path: &Path) -> Result<HistoryStore, HistoryError> {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .map_err(|error| HistoryError::Io { path: dir.to_path_buf(), error })?;
+        let unusable = |reason: String| HistoryError::Unusable { path: path.to_path_buf(), reason };
+        if path.is_dir() {
+            return Err(unusable(
+                "it is a directory (give the store's file, e.g. DIR/history.sqlite)".into(),
+            ));
         }
-        Self::open_with(path, true)
+        // What this call made, removed again if the store cannot be opened after all.
+        let mut made: Option<PathBuf> = None;
+        if !path.exists() {
+            let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            if !dir.exists() {
+                made = dir
+                    .ancestors()
+                    .take_while(|d| !d.as_os_str().is_empty() && !d.exists())
+                    .last()
+                    .map(Path::to_path_buf);
+                std::fs::create_dir_all(dir).map_err(|e| {
+                    unusable(format!("cannot create directory {}: {}", dir.display(), io_reason(&e)))
+                })?;
+            } else if !dir.is_dir() {
+                return Err(unusable(format!("{} is not a directory", dir.display())));
+            }
+            // Made here rather than by SQLite, whose error ("unable to open database file") does not
+            // say why.
+            std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(path)
+                .map_err(|e| unusable(format!("cannot create it in {}: {}", dir.display(), io_reason(&e))))?;
+            made.get_or_insert_with(|| path.to_path_buf());
+        } else if let Err(e) = std::fs::OpenOptions::new().read(true).write(true).open(path) {
+            return Err(unusable(format!("cannot open it for writing: {}", io_reason(&e))));
+        }
+        let opened = Self::open_with(path, true);
+        if let (Err(_), Some(made)) = (&opened, &made) {
+            let _ = if made.is_dir() { std::fs::remove_dir_all(made) } else { std::fs::remove_file(made) };
+        }
+        opened
     }
 
     /// Open the store at `path`; an error if there is none.
     pub fn open_existing(path: &Path) -> Result<HistoryStore, HistoryError> {
+        if path.is_dir() {
+            return Err(HistoryError::Unusable {
+                path: path.to_path_buf(),
+                reason: "it is a directory (give the store's file, e.g. DIR/history.sqlite)".into(),
+            });
+        }
         if !path.is_file() {
             return Err(HistoryError::NoStore { path: path.to_path_buf() });
         }
@@ -490,6 +531,16 @@ impl HistoryStore {
             .collect::<Result<Vec<_>, _>>()
             .map_err(self.sql())?;
         Ok(rows)
+    }
+}
+
+/// An I/O error's reason in the words of a sentence (`permission denied (os error 13)`).
+fn io_reason(e: &std::io::Error) -> String {
+    let text = e.to_string();
+    let mut chars = text.chars();
+    match chars.next() {
+        Some(first) => first.to_lowercase().chain(chars).collect(),
+        None => text,
     }
 }
 
