@@ -219,3 +219,29 @@ fn a_store_path_that_cannot_be_one_says_why_and_nothing_is_written() {
     }
     std::fs::set_permissions(&read_only, std::fs::Permissions::from_mode(0o755)).unwrap();
 }
+
+/// Item 3: a 0 where the history commands need a count (`--steps 0` ran every commit) is refused
+/// by the argument parser (exit 2), before anything runs or is written.
+#[test]
+fn a_zero_count_is_refused_before_anything_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let repo = dir.path().join("repo");
+    repository(&repo, 3);
+    let store = dir.path().join("h.sqlite");
+    let work = dir.path().join("work");
+    for (command, option) in [
+        ("run", "--steps"),
+        ("run", "--threads"),
+        ("run", "--repeat"),
+        ("find", "--threads"),
+        ("find", "--repeat"),
+    ] {
+        let mut args = vec!["history", command];
+        args.push(if command == "run" { "HEAD~2..HEAD" } else { "iterations" });
+        args.extend(["--repo", s(&repo), "--store", s(&store), "--work-dir", s(&work), option, "0"]);
+        let (code, text) = harness_in(dir.path(), &args);
+        assert_eq!(code, 2, "history {command} {option} 0: {text}");
+        assert!(text.contains(option) && text.contains("1 or more"), "history {command} {option} 0: {text}");
+        assert!(!store.exists() && !work.exists(), "history {command} {option} 0 wrote: {text}");
+    }
+}

@@ -36,9 +36,9 @@ pub(super) enum HistoryCommand {
         /// Revisions: `A..B` ranges and single commits.
         #[arg(required = true)]
         revisions: Vec<String>,
-        /// Run N commits evenly spread over the revisions (the first and last among them).
-        #[arg(long)]
-        steps: Option<usize>,
+        /// Run N commits evenly spread over the revisions (the first and last among them); N >= 1.
+        #[arg(long, value_parser = at_least_one)]
+        steps: Option<u32>,
         #[command(flatten)]
         store: StoreArgs,
         #[command(flatten)]
@@ -110,11 +110,11 @@ pub(super) struct SuiteArgs {
     /// Scenario directory, relative to each commit's checkout (e.g. configs/real-meshes).
     #[arg(long)]
     scenarios: Option<PathBuf>,
-    /// Worker threads of every method.
-    #[arg(long, default_value_t = 2)]
+    /// Worker threads of every method (1 or more).
+    #[arg(long, default_value_t = 2, value_parser = at_least_one)]
     threads: u32,
-    /// Rounds of each case: their spread is the band of the time timelines.
-    #[arg(long, default_value_t = 3)]
+    /// Rounds of each case (1 or more): their spread is the band of the time timelines.
+    #[arg(long, default_value_t = 3, value_parser = at_least_one)]
     repeat: u32,
     /// Worktree, build and logs [default: history/work next to the store].
     #[arg(long)]
@@ -128,6 +128,16 @@ pub(super) struct SuiteArgs {
     /// Keep a run of another series on timelines of its own instead of refusing it.
     #[arg(long)]
     allow_mixed: bool,
+}
+
+/// A count of the history commands, which 0 would make meaningless (`--steps 0` ran every commit,
+/// `--repeat 0` no round, `--threads 0` no worker): refused by clap, exit 2.
+fn at_least_one(text: &str) -> Result<u32, String> {
+    match text.parse::<u32>() {
+        Ok(0) => Err("0 is not allowed here: give 1 or more".to_string()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!("{e}: give a whole number, 1 or more")),
+    }
 }
 
 impl SuiteArgs {
@@ -247,7 +257,7 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
             let options = suite.options(&path)?;
             let mut commits = git::expand(&options.repo, &revisions)?;
             if let Some(n) = steps {
-                commits = git::thin(&commits, n);
+                commits = git::thin(&commits, n as usize);
             }
             let mut history = HistoryStore::open_or_create(&path)?;
             println!("{} commit(s) to run: {}", commits.len(), options.request());
