@@ -245,3 +245,43 @@ fn a_zero_count_is_refused_before_anything_runs() {
         assert!(!store.exists() && !work.exists(), "history {command} {option} 0 wrote: {text}");
     }
 }
+
+/// Item 4: `history record` stores all of its runs or none: a refused one (another machine, in the
+/// store or earlier in the same call; a dirty tree; not a results.json) is an error naming its
+/// file (exit 2), and the good runs named before it are not recorded either.
+#[test]
+fn record_stores_all_of_its_runs_or_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let store = dir.path().join("h.sqlite");
+    let record = |files: &[&Path]| {
+        let mut args = vec!["history", "record", "--store", s(&store)];
+        args.extend(files.iter().map(|f| s(f)));
+        harness_in(dir.path(), &args)
+    };
+    let r0 = write_run(dir.path(), "r0.json", &Run::clean("aaa"));
+    let (code, text) = record(&[&r0]);
+    assert_eq!(code, 0, "{text}");
+    let r4 = write_run(dir.path(), "r4.json", &Run::clean("bbb"));
+    let other_machine = write_run(dir.path(), "r1.json", &Run { cpu: "Other CPU", ..Run::clean("ccc") });
+    let dirty = write_run(dir.path(), "dirty.json", &Run { diff: Some("1a2b3c4d"), ..Run::clean("ddd") });
+    let not_results = dir.path().join("bad.json");
+    std::fs::write(&not_results, "{\"cases\": []}").unwrap();
+    for (bad, why) in
+        [(&other_machine, "Other CPU"), (&dirty, "--allow-dirty"), (&not_results, "data_source")]
+    {
+        let (code, text) = record(&[&r4, bad]);
+        assert_eq!(code, 2, "{text}");
+        assert!(text.contains(s(bad)) && text.contains(why), "{text}");
+        assert_eq!(stored_runs(&store), 1, "r4 was recorded beside a refused run: {text}");
+    }
+    // Two runs of one call that mix series, into a store that does not exist yet: no store either.
+    let fresh = dir.path().join("fresh/h.sqlite");
+    let (code, text) =
+        harness_in(dir.path(), &["history", "record", "--store", s(&fresh), s(&r4), s(&other_machine)]);
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains(s(&other_machine)) && text.contains("Other CPU"), "{text}");
+    assert!(!dir.path().join("fresh").exists(), "a refused record left a store: {text}");
+    let (code, text) = record(&[&r4]);
+    assert_eq!(code, 0, "{text}");
+    assert_eq!(stored_runs(&store), 2);
+}

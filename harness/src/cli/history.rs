@@ -234,7 +234,7 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
     match command {
         HistoryCommand::Record { reports, store, allow_mixed, allow_dirty } => {
             let path = store.path();
-            // Every run is read before the store is touched: a bad file records nothing.
+            // Every run is read and checked before the store is touched: a bad file records nothing.
             let runs = reports.iter().map(|r| run_record::read_run(r)).collect::<Result<Vec<_>, _>>()?;
             if let Some((r, _)) = reports.iter().zip(&runs).find(|(_, run)| run.dirty && !allow_dirty) {
                 anyhow::bail!(
@@ -244,8 +244,19 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
             }
             let mut history = HistoryStore::open_or_create(&path)?;
             let mixing = if allow_mixed { Mixing::Allow } else { Mixing::Refuse };
-            for (r, run) in reports.iter().zip(&runs) {
-                let outcome = history.record(run, &r.display().to_string(), mixing)?;
+            // All or nothing: one transaction, in which each run is also judged against the runs
+            // before it in this call.
+            let sources: Vec<(&run_record::RunRecord, String)> =
+                runs.iter().zip(&reports).map(|(run, r)| (run, r.display().to_string())).collect();
+            let outcomes = match history.record_all(&sources, mixing) {
+                Ok(outcomes) => outcomes,
+                Err(e) => {
+                    history.abandon();
+                    return Err(anyhow::Error::new(e)
+                        .context(format!("nothing of the {} run(s) was recorded", runs.len())));
+                }
+            };
+            for ((r, run), outcome) in reports.iter().zip(&runs).zip(outcomes) {
                 let label = format!("{} ({})", r.display(), &run.commit[..run.commit.len().min(12)]);
                 print_outcome(&label, &Outcome::Recorded(outcome));
             }

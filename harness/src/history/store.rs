@@ -126,6 +126,8 @@ pub struct Failure {
 pub struct HistoryStore {
     conn: Connection,
     path: PathBuf,
+    /// What [`HistoryStore::open_or_create`] made (the file, or the first directory it made).
+    made: Option<PathBuf>,
 }
 
 impl HistoryStore {
@@ -166,11 +168,19 @@ impl HistoryStore {
         } else if let Err(e) = std::fs::OpenOptions::new().read(true).write(true).open(path) {
             return Err(unusable(format!("cannot open it for writing: {}", io_reason(&e))));
         }
-        let opened = Self::open_with(path, true);
-        if let (Err(_), Some(made)) = (&opened, &made) {
-            let _ = if made.is_dir() { std::fs::remove_dir_all(made) } else { std::fs::remove_file(made) };
+        match Self::open_with(path, true) {
+            Ok(store) => Ok(HistoryStore { made, ..store }),
+            Err(e) => {
+                if let Some(made) = made {
+                    let _ = if made.is_dir() {
+                        std::fs::remove_dir_all(&made)
+                    } else {
+                        std::fs::remove_file(&made)
+                    };
+                }
+                Err(e)
+            }
         }
-        opened
     }
 
     /// Open the store at `path`; an error if there is none.
@@ -222,7 +232,7 @@ impl HistoryStore {
             return Err(corrupt(format!("SQLite's quick_check: {check}")));
         }
         conn.execute_batch("PRAGMA foreign_keys = ON;").map_err(sql)?;
-        Ok(HistoryStore { conn, path: path.to_path_buf() })
+        Ok(HistoryStore { conn, path: path.to_path_buf(), made: None })
     }
 
     fn sql(&self) -> impl Fn(rusqlite::Error) -> HistoryError + '_ {
@@ -248,114 +258,41 @@ impl HistoryStore {
         request: Option<&str>,
     ) -> Result<Recorded, HistoryError> {
         let path = self.path.clone();
-        let sql = move |error| HistoryError::Sqlite { path: path.clone(), error };
-        if let Some(id) = self
-            .conn
-            .query_row("SELECT id FROM runs WHERE digest = ?1", [&run.digest], |r| r.get::<_, i64>(0))
-            .optional()
-            .map_err(&sql)?
-        {
-            return Ok(Recorded::AlreadyThere { run: id });
-        }
-        let series = self.series_for(run, mixing)?;
-        let tx = self.conn.transaction().map_err(&sql)?;
-        tx.execute(
-            "INSERT INTO runs (digest, git_commit, dirty, started_utc, recorded_utc, data_source, machine_class, series,
-                               repetitions, data_files, provenance, source, request)
-             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)",
-            params![
-                run.digest,
-                run.commit,
-                run.dirty,
-                run.started_utc,
-                crate::provenance::utc_timestamp(std::time::SystemTime::now()),
-                run.series.data_source,
-                run.series.machine_class,
-                series,
-                run.repetitions as i64,
-                serde_json::to_string(&run.data_files).unwrap_or_default(),
-                run.provenance,
-                source,
-                request,
-            ],
-        )
-        .map_err(&sql)?;
-        let id = tx.last_insert_rowid();
-        let mut measurements = 0;
-        {
-            let mut case = tx
-                .prepare("INSERT INTO cases (run, scenario, method, status) VALUES (?1, ?2, ?3, ?4)")
-                .map_err(&sql)?;
-            let mut value = tx
-                .prepare(
-                    "INSERT INTO measurements (run, scenario, method, measure, value, low, high)
-                     VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
-                )
-                .map_err(&sql)?;
-            for c in &run.cases {
-                case.execute(params![id, c.scenario, c.method, c.status]).map_err(|e| {
-                    HistoryError::Results {
-                        path: PathBuf::from(source),
-                        message: format!("case {} / {}: {e} (named twice?)", c.scenario, c.method),
-                    }
-                })?;
-                for v in &c.values {
-                    value
-                        .execute(params![id, c.scenario, c.method, v.measure.key(), v.value, v.low, v.high])
-                        .map_err(&sql)?;
-                    measurements += 1;
-                }
-            }
-        }
-        tx.commit().map_err(&sql)?;
-        Ok(Recorded::Added { run: id, cases: run.cases.len(), measurements })
+        let sql = |error| HistoryError::Sqlite { path: path.clone(), error };
+        let tx = self.conn.transaction().map_err(sql)?;
+        let recorded = insert_run(&tx, &path, run, source, mixing, request)?;
+        tx.commit().map_err(sql)?;
+        Ok(recorded)
     }
 
-    /// The series `run` joins: its own label, unless the store holds runs of another series or
-    /// other data files of the same name, which only [`Mixing::Allow`] lets in (then on timelines
-    /// of their own, the label saying why).
-    fn series_for(&self, run: &RunRecord, mixing: Mixing) -> Result<String, HistoryError> {
-        let mut label = run.series.label();
-        let mut stmt = self
-            .conn
-            .prepare("SELECT DISTINCT data_source, machine_class, data_files FROM runs")
-            .map_err(self.sql())?;
-        let stored: Vec<(String, String, String)> = stmt
-            .query_map([], |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?)))
-            .map_err(self.sql())?
-            .collect::<Result<_, _>>()
-            .map_err(self.sql())?;
-        let mut conflicts = Vec::new();
-        for (data_source, machine_class, files) in &stored {
-            let key = SeriesKey { data_source: data_source.clone(), machine_class: machine_class.clone() };
-            if key != run.series {
-                conflicts.push(format!(
-                    "the store holds {}; this run is {}",
-                    key.label(),
-                    run.series.label()
-                ));
-                continue;
-            }
-            let files: BTreeMap<String, String> = serde_json::from_str::<Vec<(String, String)>>(files)
-                .unwrap_or_default()
-                .into_iter()
-                .collect();
-            for (name, sha) in &run.data_files {
-                if files.get(name).is_some_and(|s| s != sha) {
-                    conflicts.push(format!(
-                        "data file {name} differs from the store's ({} against {})",
-                        &sha[..sha.len().min(12)],
-                        &files[name][..files[name].len().min(12)]
-                    ));
-                    label = format!("{label}, other {name}");
-                }
-            }
-        }
-        conflicts.sort();
-        conflicts.dedup();
-        match (conflicts.is_empty(), mixing) {
-            (true, _) | (false, Mixing::Allow) => Ok(label),
-            (false, Mixing::Refuse) => Err(HistoryError::Mixed { path: self.path.clone(), conflicts }),
+    /// Store every one of `runs` (each with the file it was read from), or none of them: one
+    /// transaction, in which each run is judged against the store and the runs before it (two runs
+    /// of one call that would mix series are refused as one run would be). The first refusal is the
+    /// error; it names the run's file.
+    pub fn record_all(
+        &mut self,
+        runs: &[(&RunRecord, String)],
+        mixing: Mixing,
+    ) -> Result<Vec<Recorded>, HistoryError> {
+        let path = self.path.clone();
+        let sql = |error| HistoryError::Sqlite { path: path.clone(), error };
+        let tx = self.conn.transaction().map_err(sql)?;
+        let recorded = runs
+            .iter()
+            .map(|(run, source)| insert_run(&tx, &path, run, source, mixing, None))
+            .collect::<Result<Vec<_>, _>>()?;
+        tx.commit().map_err(sql)?;
+        Ok(recorded)
+    }
+
+    /// Close the store, removing it (and the directories made for it) when this call to
+    /// [`HistoryStore::open_or_create`] made it: for a command that ends in an error and must leave
+    /// nothing behind.
+    pub fn abandon(self) {
+        let HistoryStore { conn, made, .. } = self;
+        drop(conn);
+        if let Some(made) = made {
+            let _ = if made.is_dir() { std::fs::remove_dir_all(&made) } else { std::fs::remove_file(&made) };
         }
     }
 
@@ -531,6 +468,118 @@ impl HistoryStore {
             .collect::<Result<Vec<_>, _>>()
             .map_err(self.sql())?;
         Ok(rows)
+    }
+}
+
+/// Insert `run` (read from `source`) through `conn` (a transaction), unless it is there already.
+fn insert_run(
+    conn: &Connection,
+    path: &Path,
+    run: &RunRecord,
+    source: &str,
+    mixing: Mixing,
+    request: Option<&str>,
+) -> Result<Recorded, HistoryError> {
+    let sql = |error| HistoryError::Sqlite { path: path.to_path_buf(), error };
+    if let Some(id) = conn
+        .query_row("SELECT id FROM runs WHERE digest = ?1", [&run.digest], |r| r.get::<_, i64>(0))
+        .optional()
+        .map_err(sql)?
+    {
+        return Ok(Recorded::AlreadyThere { run: id });
+    }
+    let series = series_for(conn, path, run, source, mixing)?;
+    conn.execute(
+        "INSERT INTO runs (digest, git_commit, dirty, started_utc, recorded_utc, data_source, machine_class, series,
+                           repetitions, data_files, provenance, source, request)
+         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)",
+        params![
+            run.digest,
+            run.commit,
+            run.dirty,
+            run.started_utc,
+            crate::provenance::utc_timestamp(std::time::SystemTime::now()),
+            run.series.data_source,
+            run.series.machine_class,
+            series,
+            run.repetitions as i64,
+            serde_json::to_string(&run.data_files).unwrap_or_default(),
+            run.provenance,
+            source,
+            request,
+        ],
+    )
+    .map_err(sql)?;
+    let id = conn.last_insert_rowid();
+    let mut measurements = 0;
+    let mut case = conn
+        .prepare("INSERT INTO cases (run, scenario, method, status) VALUES (?1, ?2, ?3, ?4)")
+        .map_err(sql)?;
+    let mut value = conn
+        .prepare(
+            "INSERT INTO measurements (run, scenario, method, measure, value, low, high)
+             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
+        )
+        .map_err(sql)?;
+    for c in &run.cases {
+        case.execute(params![id, c.scenario, c.method, c.status]).map_err(|e| HistoryError::Results {
+            path: PathBuf::from(source),
+            message: format!("case {} / {}: {e} (named twice?)", c.scenario, c.method),
+        })?;
+        for v in &c.values {
+            value
+                .execute(params![id, c.scenario, c.method, v.measure.key(), v.value, v.low, v.high])
+                .map_err(sql)?;
+            measurements += 1;
+        }
+    }
+    Ok(Recorded::Added { run: id, cases: run.cases.len(), measurements })
+}
+
+/// The series `run` (read from `source`) joins: its own label, unless the store holds runs of
+/// another series or other data files of the same name, which only [`Mixing::Allow`] lets in (then
+/// on timelines of their own, the label saying why). A refusal names `source`.
+fn series_for(
+    conn: &Connection,
+    path: &Path,
+    run: &RunRecord,
+    source: &str,
+    mixing: Mixing,
+) -> Result<String, HistoryError> {
+    let sql = |error| HistoryError::Sqlite { path: path.to_path_buf(), error };
+    let mut label = run.series.label();
+    let mut stmt =
+        conn.prepare("SELECT DISTINCT data_source, machine_class, data_files FROM runs").map_err(sql)?;
+    let stored: Vec<(String, String, String)> = stmt
+        .query_map([], |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?)))
+        .map_err(sql)?
+        .collect::<Result<_, _>>()
+        .map_err(sql)?;
+    let mut conflicts = Vec::new();
+    for (data_source, machine_class, files) in &stored {
+        let key = SeriesKey { data_source: data_source.clone(), machine_class: machine_class.clone() };
+        if key != run.series {
+            conflicts.push(format!("the store holds {}; this run is {}", key.label(), run.series.label()));
+            continue;
+        }
+        let files: BTreeMap<String, String> =
+            serde_json::from_str::<Vec<(String, String)>>(files).unwrap_or_default().into_iter().collect();
+        for (name, sha) in &run.data_files {
+            if files.get(name).is_some_and(|s| s != sha) {
+                conflicts.push(format!(
+                    "data file {name} differs from the store's ({} against {})",
+                    &sha[..sha.len().min(12)],
+                    &files[name][..files[name].len().min(12)]
+                ));
+                label = format!("{label}, other {name}");
+            }
+        }
+    }
+    conflicts.sort();
+    conflicts.dedup();
+    match (conflicts.is_empty(), mixing) {
+        (true, _) | (false, Mixing::Allow) => Ok(label),
+        (false, Mixing::Refuse) => Err(HistoryError::Mixed { path: PathBuf::from(source), conflicts }),
     }
 }
 
