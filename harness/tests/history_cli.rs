@@ -285,3 +285,52 @@ fn record_stores_all_of_its_runs_or_none() {
     assert_eq!(code, 0, "{text}");
     assert_eq!(stored_runs(&store), 2);
 }
+
+/// Item 5: runs of a dirty tree are points of their own, the commit and their diff's hash: a step
+/// between a commit and an uncommitted change of it is named with the change
+/// (`abc1234+dirty:1a2b3c`), in `history show` and on the page, and does not blur the commit's point.
+#[test]
+fn runs_of_an_uncommitted_change_are_a_point_of_their_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let repo = dir.path().join("repo");
+    let commits = repository(&repo, 6);
+    let store = dir.path().join("h.sqlite");
+    let mut files: Vec<PathBuf> = Vec::new();
+    for (i, c) in commits.iter().enumerate() {
+        let e_theta = if i < 4 { 1.0 } else { 1.4 };
+        files.push(write_run(dir.path(), &format!("run{i}.json"), &Run { e_theta, ..Run::clean(c) }));
+    }
+    // Commit 3 with an uncommitted change that moves E_theta (the after of a before/after pair),
+    // and commit 5 with a change recorded by a harness that kept no diff hash.
+    let change = Run { diff: Some("1a2b3c4d5e6f"), e_theta: 1.4, ..Run::clean(&commits[3]) };
+    files.push(write_run(dir.path(), "changed.json", &change));
+    files.push(write_run(
+        dir.path(),
+        "old-dirty.json",
+        &Run { diff: Some(""), e_theta: 1.4, ..Run::clean(&commits[5]) },
+    ));
+    let mut args = vec!["history", "record", "--allow-dirty", "--store", s(&store)];
+    args.extend(files.iter().map(|f| s(f)));
+    let (code, text) = harness_in(dir.path(), &args);
+    assert_eq!(code, 0, "{text}");
+    assert!(text.contains(&format!("{}+dirty:1a2b3c", &commits[3][..12])), "{text}");
+
+    let out = dir.path().join("page");
+    let (code, text) = harness_in(
+        dir.path(),
+        &["history", "show", "--store", s(&store), "--repo", s(&repo), "--out", s(&out)],
+    );
+    assert_eq!(code, 0, "{text}");
+    let point = format!("{}+dirty:1a2b3c", &commits[3][..7]);
+    assert!(text.contains("6 commits and 2 uncommitted change(s)"), "{text}");
+    let steps: Vec<&str> = text.lines().filter(|l| l.contains(" -> ")).collect();
+    assert_eq!(steps.len(), 1, "{text}");
+    assert!(steps[0].contains("e_theta_deg") && steps[0].contains(&point), "{text}");
+    assert!(std::fs::read_to_string(out.join("steps.md")).unwrap().contains(&point));
+    let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(index.contains(&format!("<code>{point}</code>")), "the commits table lists the change");
+    assert!(
+        index.contains(&format!("<code>{}+dirty</code>", &commits[5][..7])),
+        "and the one without a hash"
+    );
+}

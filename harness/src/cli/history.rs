@@ -238,7 +238,7 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
             let runs = reports.iter().map(|r| run_record::read_run(r)).collect::<Result<Vec<_>, _>>()?;
             if let Some((r, _)) = reports.iter().zip(&runs).find(|(_, run)| run.dirty && !allow_dirty) {
                 anyhow::bail!(
-                    "{}: made from a tree that differed from its commit (git_dirty); its values belong to no commit. --allow-dirty records it anyway",
+                    "{}: made from a tree that differed from its commit (git_dirty); its values belong to no commit. --allow-dirty records it as a point of its own (the commit, +dirty: and its diff's hash)",
                     r.display()
                 );
             }
@@ -257,7 +257,9 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
                 }
             };
             for ((r, run), outcome) in reports.iter().zip(&runs).zip(outcomes) {
-                let label = format!("{} ({})", r.display(), &run.commit[..run.commit.len().min(12)]);
+                let point =
+                    run_record::point_label(&run.commit, 12, run.diff.as_deref().or(run.dirty.then_some("")));
+                let label = format!("{} ({point})", r.display());
                 print_outcome(&label, &Outcome::Recorded(outcome));
             }
             println!("store: {}", path.display());
@@ -309,8 +311,8 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
             let index = page::write_page(&out, &built, &path)?;
             let steps = page::all_steps(&built);
             println!(
-                "{} commits, {} timelines, {} step(s){}",
-                built.commits.len(),
+                "{}, {} timelines, {} step(s){}",
+                page::points_text(&built),
                 built.timelines.len(),
                 steps.len(),
                 if steps.is_empty() { "" } else { ":" }
@@ -345,7 +347,7 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
                     f.step.before,
                     f.step.after,
                     100.0 * f.step.relative,
-                    f.commit.short(),
+                    f.commit.label(),
                     page::short_subject(&f.commit.subject),
                     f.runs
                 );

@@ -95,6 +95,9 @@ pub enum Recorded {
 pub struct StoredRun {
     pub id: i64,
     pub commit: String,
+    /// `None` for a run of the commit's own tree; for a dirty tree the SHA-256 of its change
+    /// ([`RunRecord::diff`], kept in the provenance), or `""` when the run did not record one.
+    pub dirty: Option<String>,
     pub started_utc: String,
     pub series: String,
     pub repetitions: usize,
@@ -300,13 +303,23 @@ impl HistoryStore {
     pub fn runs(&self) -> Result<Vec<StoredRun>, HistoryError> {
         let mut stmt = self
             .conn
-            .prepare("SELECT id, git_commit, started_utc, series, repetitions, source FROM runs ORDER BY id")
+            .prepare(
+                "SELECT id, git_commit, started_utc, series, repetitions, source, dirty, provenance FROM runs ORDER BY id",
+            )
             .map_err(self.sql())?;
         let rows = stmt
             .query_map([], |r| {
+                let dirty = r.get::<_, bool>(6)?.then(|| {
+                    let provenance: String = r.get(7).unwrap_or_default();
+                    serde_json::from_str::<serde_json::Value>(&provenance)
+                        .ok()
+                        .and_then(|p| p["build"]["git_diff_sha256"].as_str().map(str::to_string))
+                        .unwrap_or_default()
+                });
                 Ok(StoredRun {
                     id: r.get(0)?,
                     commit: r.get(1)?,
+                    dirty,
                     started_utc: r.get(2)?,
                     series: r.get(3)?,
                     repetitions: r.get::<_, i64>(4)? as usize,
