@@ -334,3 +334,74 @@ fn runs_of_an_uncommitted_change_are_a_point_of_their_own() {
         "and the one without a hash"
     );
 }
+
+/// A report directory `dir` with a results.json of one `--repeat 3` run of `commit` (`diff`: the
+/// hash of an uncommitted change) with isolines on the bar taking `total_ms` (+-2.5%), split
+/// 1:1:2 into precompute, bind and solve.
+fn write_compared_run(dir: &Path, commit: &str, diff: Option<&str>, total_ms: f64) {
+    let t = total_ms / 1e3;
+    let spread = |v: f64| serde_json::json!({ "min": v * 0.975, "max": v * 1.025 });
+    let case = serde_json::json!({
+        "scenario": "bar", "method": "isolines", "mesh_source": "procedural look-alike", "vertices": 600,
+        "faces": 1196, "precompute_s": t / 4.0, "bind_s": t / 4.0, "median_iteration_ms": 0.1,
+        "iterations": 5, "solve_s": t / 2.0, "total_s": t, "converged": true, "e_theta_deg": 1.0,
+        "e_phi_deg": 1.0, "handle_residual_over_diag": 0.0, "rms_to_arap_over_diag": null, "status": "ok",
+        "phase_timings": [], "statistics": [], "steps": [], "trace": [],
+        "spread": { "repetitions": 3, "precompute_s": spread(t / 4.0), "bind_s": spread(t / 4.0),
+                    "solve_s": spread(t / 2.0), "total_s": spread(t), "median_iteration_ms": spread(0.1) }
+    });
+    let provenance = serde_json::json!({
+        "machine": { "cpu_model": "Test CPU", "logical_cores": 2, "memory_gib": 8.0, "os": "Debian", "kernel": "6.1" },
+        "build": { "version": "0.1.0", "git_commit": commit, "git_dirty": diff.is_some(),
+                   "git_diff_sha256": diff, "rustc": "rustc 1.87.0", "profile": "release" },
+        "run": { "started_utc": "2026-12-06T00:00:00Z", "command_line": ["harness", "all", "--repeat", "3"],
+                 "threads": 2, "jobs": 1, "repetitions": 3 },
+        "inputs": [{ "path": "/x/configs/methods.toml", "sha256": "11" },
+                   { "path": "/x/configs/scenarios/bar.toml", "sha256": "22" }]
+    });
+    let report = serde_json::json!({
+        "generator": "test", "data_source": "procedural look-alikes", "units": "", "provenance": provenance,
+        "cases": [case]
+    });
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(dir.join("results.json"), serde_json::to_vec_pretty(&report).unwrap()).unwrap();
+}
+
+/// Item 7: two runs of one commit whose millisecond case differs by 1.39x with min–max ranges
+/// apart (what `--repeat 3` gave on one machine) are said to be runs of the same commit and inputs
+/// and judged the same within noise (exit 0 under --fail-on slower); a threefold change of
+/// another commit is still slower (exit 4).
+#[test]
+fn compare_of_two_runs_of_one_commit_says_so_and_calls_millisecond_jitter_noise() {
+    let dir = tempfile::tempdir().unwrap();
+    let commit = "0123456789abcdef0123456789abcdef01234567";
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    write_compared_run(&a, commit, None, 2.0);
+    write_compared_run(&b, commit, None, 2.78);
+    let out = dir.path().join("comparison");
+    let compare = |a: &Path, b: &Path| {
+        harness_in(dir.path(), &["compare", s(a), s(b), "--out", s(&out), "--fail-on", "slower"])
+    };
+    let (code, text) = compare(&a, &b);
+    assert_eq!(code, 0, "{text}");
+    let first = text.lines().find(|l| !l.trim().is_empty() && !l.starts_with('#')).unwrap_or("");
+    assert_eq!(first, "same commit and inputs: differences are noise", "{text}");
+    let md = std::fs::read_to_string(out.join("compare.md")).unwrap();
+    assert!(md.contains("| bar | isolines |") && md.contains("same within noise"), "{md}");
+    assert!(!md.contains("| slower |"), "{md}");
+
+    // The same change of another uncommitted state is not "the same commit".
+    let c = dir.path().join("c");
+    write_compared_run(&c, commit, Some("1a2b3c4d"), 2.78);
+    let (code, text) = compare(&a, &c);
+    assert_eq!(code, 0, "{text}");
+    assert!(!text.contains("same commit and inputs"), "{text}");
+    // Three times as long, at another commit: slower.
+    let d = dir.path().join("d");
+    write_compared_run(&d, "fedcba9876543210fedcba9876543210fedcba98", None, 6.0);
+    let (code, text) = compare(&a, &d);
+    assert_eq!(code, 4, "{text}");
+    assert!(!text.contains("same commit and inputs"), "{text}");
+    let md = std::fs::read_to_string(out.join("compare.md")).unwrap();
+    assert!(md.contains("| bar | isolines |") && md.contains("| slower |"), "{md}");
+}
