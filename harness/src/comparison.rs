@@ -1,7 +1,10 @@
 //! `harness compare A B`: two runs side by side, case by case. Timings are judged against their
-//! spread over the repetitions (`--repeat`): B is *slower* or *faster* than A only when the min–max
-//! ranges of the two runs do not overlap and the medians differ by at least `min_change`; else they
-//! are the same within noise. A run of one repetition has no spread, so its timings are not judged.
+//! noise: B is *slower* or *faster* than A only when the noise bands of the two runs do not overlap
+//! and the medians differ by at least `min_change`; else they are the same within noise. A band is
+//! the min–max range over the repetitions (`--repeat`), widened to an absolute floor for
+//! millisecond timings ([`noise_band`]). A run of one repetition has no spread, so its timings are
+//! not judged. Two runs of the same commit (same tree) with the same inputs are said to be that at
+//! the top ([`Comparison::same_commit_and_inputs`]): whatever differs between them is noise.
 //! Quality is judged as the regression gate judges it, with A as the baseline
 //! ([`crate::regression::check`], the metric table's tolerances). Whatever differs between the runs
 //! beyond the commit (machine, threads, jobs, repetitions, build profile, data, input files) is a
@@ -18,6 +21,23 @@ use crate::stored_report::{read_results, StoredReport};
 
 /// The default smallest change of a median that can be called slower or faster: 5%.
 pub const DEFAULT_MIN_CHANGE: f64 = 0.05;
+
+/// The narrowest noise band of a timing measured as one interval (start-up, precompute, bind,
+/// solve, total), seconds: 2 ms, centred on the median.
+///
+/// Decision (issue 60): two `--repeat 3` runs of one commit on one machine called `isolines` 1.39x
+/// slower on millisecond cases, because three rounds of a 2 ms case scatter by a few hundredths of
+/// a millisecond within a run while the runs differ by most of a millisecond (frequency scaling,
+/// cache and page state, the scheduler): min–max ranges that do not overlap by chance. So a band is
+/// the measured range, but at least 2 ms wide: the change of a sub-10 ms case must exceed 2 ms
+/// (20% at 10 ms, more below) to be called a change. Above some 40 ms the floor is below the 5%
+/// of `--min-change` and no longer matters.
+pub const NOISE_FLOOR_S: f64 = 0.002;
+
+/// The narrowest noise band of the median iteration, as a fraction of it: 20%. An iteration takes
+/// microseconds to milliseconds, so the absolute floor would leave it never judged; 20% is what
+/// [`NOISE_FLOOR_S`] is at 10 ms.
+pub const ITERATION_NOISE_FLOOR: f64 = 0.2;
 
 /// One run of a comparison: where it was read from and what it holds.
 pub struct ComparedRun {
@@ -101,15 +121,27 @@ pub struct PhaseChange {
     pub speed: Speed,
 }
 
-/// Judge B's timing against A's: slower or faster only when the min–max ranges do not overlap and
-/// the medians differ by at least `min_change` (a fraction); not judged without a spread on both
-/// sides.
-pub fn judge_speed(a: Timing, b: Timing, min_change: f64) -> Speed {
+/// The noise band of timing `t` of `phase`: its min–max range over the repetitions, widened to at
+/// least [`NOISE_FLOOR_S`] (the median iteration: [`ITERATION_NOISE_FLOOR`] of it) centred on its
+/// median.
+pub fn noise_band(phase: TimedPhase, t: Timing) -> (f64, f64) {
+    let floor = match phase {
+        TimedPhase::Iteration => ITERATION_NOISE_FLOOR * t.median.abs(),
+        _ => NOISE_FLOOR_S,
+    };
+    (t.min.min(t.median - floor / 2.0), t.max.max(t.median + floor / 2.0))
+}
+
+/// Judge B's timing of `phase` against A's: slower or faster only when their noise bands
+/// ([`noise_band`]) do not overlap and the medians differ by at least `min_change` (a fraction);
+/// not judged without a spread on both sides.
+pub fn judge_speed(phase: TimedPhase, a: Timing, b: Timing, min_change: f64) -> Speed {
     let finite = |t: Timing| t.median.is_finite() && t.min.is_finite() && t.max.is_finite();
     if !finite(a) || !finite(b) || a.repetitions < 2 || b.repetitions < 2 || a.median <= 0.0 {
         return Speed::NotJudged;
     }
-    let overlap = a.min <= b.max && b.min <= a.max;
+    let ((a_low, a_high), (b_low, b_high)) = (noise_band(phase, a), noise_band(phase, b));
+    let overlap = a_low <= b_high && b_low <= a_high;
     let ratio = b.median / a.median;
     if overlap || (ratio - 1.0).abs() < min_change {
         Speed::SameWithinNoise
@@ -164,6 +196,10 @@ pub struct Comparison {
     pub b_record: String,
     /// What differs between the runs beyond the commit, and anything that weakens the comparison.
     pub warnings: Vec<String>,
+    /// Both runs are of the same commit, from a clean tree or the same uncommitted change (the same
+    /// diff hash), and read the same inputs (every file's SHA-256): any difference between them is
+    /// the machine's noise, and the report says so at the top.
+    pub same_commit_and_inputs: bool,
     /// Cases of both runs, in B's order.
     pub cases: Vec<CaseChange>,
     /// `scenario / method` of cases in only one of the runs.
@@ -222,7 +258,7 @@ pub fn compare(a: &ComparedRun, b: &ComparedRun, min_change: f64) -> Comparison 
                     a: ta,
                     b: tb,
                     ratio: tb.median / ta.median,
-                    speed: judge_speed(ta, tb, min_change),
+                    speed: judge_speed(phase, ta, tb, min_change),
                 }
             })
             .collect();
@@ -255,11 +291,35 @@ pub fn compare(a: &ComparedRun, b: &ComparedRun, min_change: f64) -> Comparison 
         a_record: record(ra),
         b_record: record(rb),
         warnings: warnings(ra, rb),
+        same_commit_and_inputs: same_commit_and_inputs(ra, rb),
         cases,
         only_in_a,
         only_in_b,
         min_change,
     }
+}
+
+/// The line at the top of a comparison of two runs of one commit and the same inputs.
+pub const SAME_COMMIT_AND_INPUTS: &str = "same commit and inputs: differences are noise";
+
+/// Whether `a` and `b` ran the same code on the same data: the same commit with a clean tree, or
+/// with the same uncommitted change (its diff hash; a dirty tree without one is never the same),
+/// the same data source and the same input files (by SHA-256, wherever they were read from).
+fn same_commit_and_inputs(a: &StoredReport, b: &StoredReport) -> bool {
+    let (Some(pa), Some(pb)) = (&a.provenance, &b.provenance) else { return false };
+    let tree = |p: &Provenance| -> Option<(String, Option<String>)> {
+        let commit = p.build.git_commit.clone()?;
+        match p.build.git_dirty? {
+            false => Some((commit, None)),
+            true => Some((commit, Some(p.build.git_diff_sha256.clone()?))),
+        }
+    };
+    tree(pa).is_some()
+        && tree(pa) == tree(pb)
+        && a.data_source == b.data_source
+        && !pa.inputs.is_empty()
+        && pa.inputs.len() == pb.inputs.len()
+        && input_differences(pa, pb).is_empty()
 }
 
 /// The case a finding is about (`Missing` ones are the cases only in A, listed apart).
@@ -399,6 +459,32 @@ mod tests {
 
     fn timing(median: f64, min: f64, max: f64, repetitions: usize) -> Timing {
         Timing { median, min, max, repetitions }
+    }
+
+    fn judge_speed(a: Timing, b: Timing, min_change: f64) -> Speed {
+        super::judge_speed(TimedPhase::Total, a, b, min_change)
+    }
+
+    #[test]
+    fn millisecond_timings_change_only_beyond_the_absolute_floor() {
+        // Issue 60: two runs of one commit, 2.0 and 2.78 ms with tight ranges apart: noise.
+        let a = timing(0.0020, 0.00195, 0.00205, 3);
+        let b = timing(0.00278, 0.00272, 0.00285, 3);
+        assert_eq!(judge_speed(a, b, 0.05), Speed::SameWithinNoise);
+        // Three times as long is beyond 2 ms: slower, and the other way faster.
+        let c = timing(0.0060, 0.0059, 0.0061, 3);
+        assert_eq!(judge_speed(a, c, 0.05), Speed::Slower);
+        assert_eq!(judge_speed(c, a, 0.05), Speed::Faster);
+        // Seconds are judged by their ranges as before.
+        assert_eq!(
+            judge_speed(timing(1.0, 0.999, 1.001, 3), timing(1.1, 1.099, 1.101, 3), 0.05),
+            Speed::Slower
+        );
+        // The median iteration's floor is 20% of it, not 2 ms.
+        let it = |m: f64| timing(m, m * 0.99, m * 1.01, 3);
+        let iteration = |a, b| super::judge_speed(TimedPhase::Iteration, a, b, 0.05);
+        assert_eq!(iteration(it(1e-4), it(1.15e-4)), Speed::SameWithinNoise);
+        assert_eq!(iteration(it(1e-4), it(1.5e-4)), Speed::Slower);
     }
 
     #[test]

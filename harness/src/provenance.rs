@@ -1,6 +1,7 @@
 //! Where and how a run was made, written at the top of `results.json` and of the page: the machine
-//! (CPU, logical cores, memory, OS and kernel), the build (crate version, git commit of the workspace
-//! and whether its tree was dirty when the run started, rustc, profile) and the run (start time,
+//! (CPU, logical cores, memory, OS and kernel), the build (crate version, git commit of the workspace,
+//! whether its tree was dirty when the run started and then the SHA-256 of its diff, rustc, profile)
+//! and the run (start time,
 //! command line, threads, jobs, repetitions). Anything that cannot be read is `unknown`, never an
 //! error: a record is a courtesy to the reader, not a precondition of the run.
 
@@ -43,6 +44,10 @@ pub struct Build {
     pub git_commit: Option<String>,
     /// Whether tracked files differed from that commit when the run started.
     pub git_dirty: Option<bool>,
+    /// When dirty: the SHA-256 of the uncommitted change ([`diff_sha256`]), so that runs of two
+    /// states of one commit's tree are told apart (the history keeps them as points of their own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub git_diff_sha256: Option<String>,
     pub rustc: String,
     /// `release` or `debug`.
     pub profile: String,
@@ -88,7 +93,10 @@ impl Provenance {
         let m = &self.machine;
         let b = &self.build;
         let commit = match (&b.git_commit, b.git_dirty) {
-            (Some(c), Some(true)) => format!("{} (dirty)", &c[..c.len().min(12)]),
+            (Some(c), Some(true)) => match &b.git_diff_sha256 {
+                Some(d) => format!("{} (dirty, diff {})", &c[..c.len().min(12)], &d[..d.len().min(12)]),
+                None => format!("{} (dirty)", &c[..c.len().min(12)]),
+            },
             (Some(c), _) => c[..c.len().min(12)].to_string(),
             (None, _) => UNKNOWN.to_string(),
         };
@@ -165,14 +173,45 @@ impl Build {
             .as_ref()
             .and_then(|_| git(&["status", "--porcelain", "--untracked-files=no"]))
             .map(|status| !status.is_empty());
+        let git_diff_sha256 = if git_dirty == Some(true) { diff_sha256(&root) } else { None };
         Build {
             version: env!("CARGO_PKG_VERSION").to_string(),
             git_commit,
             git_dirty,
+            git_diff_sha256,
             rustc: env!("DEFORMBENCH_RUSTC_VERSION").to_string(),
             profile: env!("DEFORMBENCH_PROFILE").to_string(),
         }
     }
+}
+
+/// The SHA-256 (hex) of the uncommitted change of the git checkout at `repo`: the bytes of `git diff
+/// HEAD --binary`, staged and unstaged changes of tracked files, with the options that the user's
+/// git configuration could change fixed (no external diff, textconv, colour or renames, `a/` and
+/// `b/` prefixes). Decision: untracked files are not part of it, as they are not of `git_dirty`
+/// (`git status --untracked-files=no`): reports, logs and scratch files in a checkout would make
+/// every run a state of its own. A new source file counts once it is added (`git add -N` is
+/// enough). `None` when git cannot say.
+pub fn diff_sha256(repo: &std::path::Path) -> Option<String> {
+    use sha2::Digest;
+    let out = std::process::Command::new("git")
+        .arg("-C")
+        .arg(repo)
+        .args([
+            "diff",
+            "HEAD",
+            "--binary",
+            "--no-ext-diff",
+            "--no-textconv",
+            "--no-color",
+            "--no-renames",
+            "--src-prefix=a/",
+            "--dst-prefix=b/",
+        ])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())?;
+    Some(sha2::Sha256::digest(&out.stdout).iter().map(|b| format!("{b:02x}")).collect())
 }
 
 /// An external method and its own account of itself.
@@ -293,6 +332,39 @@ mod tests {
         assert_eq!(inputs.len(), 1);
         // FIPS 180-2's test vector.
         assert_eq!(inputs[0].sha256, "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+    }
+
+    #[test]
+    fn the_diff_hash_tells_states_of_a_tree_apart_and_ignores_untracked_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let repo = dir.path();
+        let git = |args: &[&str]| {
+            let out = std::process::Command::new("git")
+                .arg("-C")
+                .arg(repo)
+                .args(["-c", "user.name=t", "-c", "user.email=t@t", "-c", "commit.gpgsign=false"])
+                .args(args)
+                .output()
+                .unwrap();
+            assert!(out.status.success(), "git {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        };
+        git(&["init", "--quiet"]);
+        std::fs::write(repo.join("a.txt"), "one\n").unwrap();
+        git(&["add", "a.txt"]);
+        git(&["commit", "--quiet", "-m", "one"]);
+        let clean = diff_sha256(repo).unwrap();
+        std::fs::write(repo.join("a.txt"), "two\n").unwrap();
+        let two = diff_sha256(repo).unwrap();
+        std::fs::write(repo.join("a.txt"), "three\n").unwrap();
+        let three = diff_sha256(repo).unwrap();
+        assert!(clean != two && two != three, "{clean} {two} {three}");
+        std::fs::write(repo.join("a.txt"), "two\n").unwrap();
+        assert_eq!(diff_sha256(repo).unwrap(), two, "the same change, the same hash");
+        git(&["add", "a.txt"]);
+        assert_eq!(diff_sha256(repo).unwrap(), two, "staged or not, the same change");
+        std::fs::write(repo.join("scratch.txt"), "untracked").unwrap();
+        assert_eq!(diff_sha256(repo).unwrap(), two, "an untracked file is not part of it");
+        assert_eq!(diff_sha256(&repo.join("no-such-dir")), None);
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! `harness history`: record runs, fill the store from commits, show timelines, bisect a step.
 
-use std::path::PathBuf;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Args, Subcommand};
@@ -35,9 +36,9 @@ pub(super) enum HistoryCommand {
         /// Revisions: `A..B` ranges and single commits.
         #[arg(required = true)]
         revisions: Vec<String>,
-        /// Run N commits evenly spread over the revisions (the first and last among them).
-        #[arg(long)]
-        steps: Option<usize>,
+        /// Run N commits evenly spread over the revisions (the first and last among them); N >= 1.
+        #[arg(long, value_parser = at_least_one)]
+        steps: Option<u32>,
         #[command(flatten)]
         store: StoreArgs,
         #[command(flatten)]
@@ -50,6 +51,10 @@ pub(super) enum HistoryCommand {
         commits: Vec<String>,
         #[command(flatten)]
         store: StoreArgs,
+        /// The git checkout the commits are named in [default: the repository of the current
+        /// directory; without one, a commit is found by its hash's first digits among the stored].
+        #[arg(long)]
+        repo: Option<PathBuf>,
     },
     /// Write the history page: timelines per scenario × method (PNG), steps named with commits.
     Show {
@@ -58,7 +63,8 @@ pub(super) enum HistoryCommand {
         /// Where index.html, steps.md and plots/ go [default: history/page next to the store].
         #[arg(long)]
         out: Option<PathBuf>,
-        /// The git checkout whose history orders the commits [default: this workspace's].
+        /// The git checkout whose history orders the commits [default: the repository of the current
+        /// directory].
         #[arg(long)]
         repo: Option<PathBuf>,
     },
@@ -80,8 +86,8 @@ pub(super) enum HistoryCommand {
 
 #[derive(Args, Clone)]
 pub(super) struct StoreArgs {
-    /// The history store [env: DEFORMBENCH_HISTORY; default: history/history.sqlite in the
-    /// workspace].
+    /// The history store [env: DEFORMBENCH_HISTORY] [default: ./history/history.sqlite, relative to
+    /// the current directory].
     #[arg(long)]
     store: Option<PathBuf>,
 }
@@ -104,15 +110,18 @@ pub(super) struct SuiteArgs {
     /// Scenario directory, relative to each commit's checkout (e.g. configs/real-meshes).
     #[arg(long)]
     scenarios: Option<PathBuf>,
-    /// Worker threads of every method.
-    #[arg(long, default_value_t = 2)]
+    /// Worker threads of every method (1 or more).
+    #[arg(long, default_value_t = 2, value_parser = at_least_one)]
     threads: u32,
-    /// Rounds of each case: their spread is the band of the time timelines.
-    #[arg(long, default_value_t = 3)]
+    /// Rounds of each case (1 or more): their spread is the band of the time timelines.
+    #[arg(long, default_value_t = 3, value_parser = at_least_one)]
     repeat: u32,
     /// Worktree, build and logs [default: history/work next to the store].
     #[arg(long)]
     work_dir: Option<PathBuf>,
+    /// The git checkout whose commits are run [default: the repository of the current directory].
+    #[arg(long)]
+    repo: Option<PathBuf>,
     /// Retry commits that failed to build or run before.
     #[arg(long)]
     retry_failed: bool,
@@ -121,9 +130,19 @@ pub(super) struct SuiteArgs {
     allow_mixed: bool,
 }
 
+/// A count of the history commands, which 0 would make meaningless (`--steps 0` ran every commit,
+/// `--repeat 0` no round, `--threads 0` no worker): refused by clap, exit 2.
+fn at_least_one(text: &str) -> Result<u32, String> {
+    match text.parse::<u32>() {
+        Ok(0) => Err("0 is not allowed here: give 1 or more".to_string()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!("{e}: give a whole number, 1 or more")),
+    }
+}
+
 impl SuiteArgs {
     fn options(&self, store: &std::path::Path) -> anyhow::Result<CollectOptions> {
-        let repo = git::repository_root(&crate::paths::current_dir_join("."))?;
+        let repo = history::repository(self.repo.as_deref())?;
         let mut suite_args = vec![
             "--threads".to_string(),
             self.threads.to_string(),
@@ -170,23 +189,77 @@ fn print_outcome(label: &str, outcome: &Outcome) {
     }
 }
 
+/// The stored commit `name` means for `history forget`: git's reading of it in `repo`, else the one
+/// stored hash that begins with it; an error naming it when the store holds no runs (nor failures)
+/// of it.
+fn forget_target(
+    name: &str,
+    repo: Option<&Path>,
+    stored: &BTreeMap<String, (usize, usize)>,
+    store: &Path,
+) -> anyhow::Result<String> {
+    if let Some(sha) = repo.and_then(|r| git::resolve(r, name).ok()) {
+        anyhow::ensure!(
+            stored.contains_key(&sha),
+            "{name} ({}): no runs of it are stored in {}; nothing removed",
+            &sha[..sha.len().min(12)],
+            store.display()
+        );
+        return Ok(sha);
+    }
+    let prefix = name.to_ascii_lowercase();
+    let matches: Vec<&String> = if prefix.len() >= 4 && prefix.chars().all(|c| c.is_ascii_hexdigit()) {
+        stored.keys().filter(|k| k.starts_with(&prefix)).collect()
+    } else {
+        Vec::new()
+    };
+    match matches[..] {
+        [one] => Ok(one.clone()),
+        [] => anyhow::bail!(
+            "{name}: no runs of it are stored in {}{}; nothing removed",
+            store.display(),
+            match repo {
+                Some(r) => format!(", and it is not a commit of {}", r.display()),
+                None => " (and no git repository here to read it in; --repo names one)".to_string(),
+            }
+        ),
+        _ => anyhow::bail!(
+            "{name}: the hashes of {} stored commits begin with it; give more digits; nothing removed",
+            matches.len()
+        ),
+    }
+}
+
 pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
     match command {
         HistoryCommand::Record { reports, store, allow_mixed, allow_dirty } => {
             let path = store.path();
-            // Every run is read before the store is touched: a bad file records nothing.
+            // Every run is read and checked before the store is touched: a bad file records nothing.
             let runs = reports.iter().map(|r| run_record::read_run(r)).collect::<Result<Vec<_>, _>>()?;
             if let Some((r, _)) = reports.iter().zip(&runs).find(|(_, run)| run.dirty && !allow_dirty) {
                 anyhow::bail!(
-                    "{}: made from a tree that differed from its commit (git_dirty); its values belong to no commit. --allow-dirty records it anyway",
+                    "{}: made from a tree that differed from its commit (git_dirty); its values belong to no commit. --allow-dirty records it as a point of its own (the commit, +dirty: and its diff's hash)",
                     r.display()
                 );
             }
             let mut history = HistoryStore::open_or_create(&path)?;
             let mixing = if allow_mixed { Mixing::Allow } else { Mixing::Refuse };
-            for (r, run) in reports.iter().zip(&runs) {
-                let outcome = history.record(run, &r.display().to_string(), mixing)?;
-                let label = format!("{} ({})", r.display(), &run.commit[..run.commit.len().min(12)]);
+            // All or nothing: one transaction, in which each run is also judged against the runs
+            // before it in this call.
+            let sources: Vec<(&run_record::RunRecord, String)> =
+                runs.iter().zip(&reports).map(|(run, r)| (run, r.display().to_string())).collect();
+            let outcomes = match history.record_all(&sources, mixing) {
+                Ok(outcomes) => outcomes,
+                Err(e) => {
+                    history.abandon();
+                    return Err(anyhow::Error::new(e)
+                        .context(format!("nothing of the {} run(s) was recorded", runs.len())));
+                }
+            };
+            for ((r, run), outcome) in reports.iter().zip(&runs).zip(outcomes) {
+                let point =
+                    run_record::point_label(&run.commit, 12, run.diff.as_deref().or(run.dirty.then_some("")));
+                let label = format!("{} ({point})", r.display());
                 print_outcome(&label, &Outcome::Recorded(outcome));
             }
             println!("store: {}", path.display());
@@ -197,7 +270,7 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
             let options = suite.options(&path)?;
             let mut commits = git::expand(&options.repo, &revisions)?;
             if let Some(n) = steps {
-                commits = git::thin(&commits, n);
+                commits = git::thin(&commits, n as usize);
             }
             let mut history = HistoryStore::open_or_create(&path)?;
             println!("{} commit(s) to run: {}", commits.len(), options.request());
@@ -209,27 +282,37 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
             println!("store: {}", path.display());
             Ok(if failed > 0 { ExitCode::from(super::EXIT_CASE_FAILED) } else { ExitCode::SUCCESS })
         }
-        HistoryCommand::Forget { commits, store } => {
+        HistoryCommand::Forget { commits, store, repo } => {
             let path = store.path();
-            let repo = git::repository_root(&crate::paths::current_dir_join("."))?;
             let mut history = HistoryStore::open_existing(&path)?;
-            for c in &commits {
-                let sha = git::resolve(&repo, c).unwrap_or_else(|_| c.clone());
-                println!("{c}: {} run(s) removed", history.forget(&sha)?);
+            // Without a repository a commit is still found among the stored by its first digits.
+            let repo = match repo {
+                Some(dir) => Some(history::repository(Some(&dir))?),
+                None => history::repository(None).ok(),
+            };
+            let stored = history.stored_commits()?;
+            // Every name is resolved and checked first: one that names no stored commit removes
+            // nothing, not even the runs of the others.
+            let shas = commits
+                .iter()
+                .map(|c| forget_target(c, repo.as_deref(), &stored, &path))
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            for (c, n) in commits.iter().zip(history.forget_all(&shas)?) {
+                println!("{c}: {n} run(s) removed");
             }
             Ok(ExitCode::SUCCESS)
         }
         HistoryCommand::Show { store, out, repo } => {
             let path = store.path();
             let history_store = HistoryStore::open_existing(&path)?;
-            let repo = git::repository_root(&repo.unwrap_or_else(|| crate::paths::current_dir_join(".")))?;
+            let repo = history::repository(repo.as_deref())?;
             let built = timeline::build(&history_store, &repo)?;
             let out = out.unwrap_or_else(|| path.parent().unwrap_or(std::path::Path::new(".")).join("page"));
             let index = page::write_page(&out, &built, &path)?;
             let steps = page::all_steps(&built);
             println!(
-                "{} commits, {} timelines, {} step(s){}",
-                built.commits.len(),
+                "{}, {} timelines, {} step(s){}",
+                page::points_text(&built),
                 built.timelines.len(),
                 steps.len(),
                 if steps.is_empty() { "" } else { ":" }
@@ -264,7 +347,7 @@ pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
                     f.step.before,
                     f.step.after,
                     100.0 * f.step.relative,
-                    f.commit.short(),
+                    f.commit.label(),
                     page::short_subject(&f.commit.subject),
                     f.runs
                 );

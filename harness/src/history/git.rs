@@ -84,10 +84,14 @@ pub fn thin(commits: &[String], n: usize) -> Vec<String> {
     picked
 }
 
-/// What the history shows of a commit.
+/// What the history shows of a commit, or of an uncommitted change of it (a point of the
+/// timelines: runs of a dirty tree are points of their own, [`CommitInfo::dirty`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CommitInfo {
     pub sha: String,
+    /// `None`: the commit as committed. `Some(hash)`: runs of its tree with an uncommitted change,
+    /// the SHA-256 of that change (`""` when the runs did not record one).
+    pub dirty: Option<String>,
     /// Committer time, seconds since the epoch.
     pub time: i64,
     pub date: String,
@@ -99,6 +103,26 @@ pub struct CommitInfo {
 impl CommitInfo {
     pub fn short(&self) -> &str {
         &self.sha[..self.sha.len().min(7)]
+    }
+
+    /// The point for people: the short hash, with `+dirty:1a2b3c` for an uncommitted change
+    /// ([`super::run_record::point_label`]).
+    pub fn label(&self) -> String {
+        super::run_record::point_label(&self.sha, 7, self.dirty.as_deref())
+    }
+
+    /// Whether `self` comes right after `before`, so that a step between them is `self`'s doing:
+    /// a commit after its first parent as committed, or an uncommitted change after its own commit
+    /// as committed. (A commit after an uncommitted change of its parent is not: the step could be
+    /// the change's.)
+    pub fn follows(&self, before: &CommitInfo) -> bool {
+        if before.dirty.is_some() {
+            return false;
+        }
+        match self.dirty {
+            None => self.parent.as_deref() == Some(before.sha.as_str()),
+            Some(_) => self.sha == before.sha,
+        }
     }
 }
 
@@ -115,6 +139,7 @@ pub fn infos(repo: &Path, shas: &[String]) -> HashMap<String, CommitInfo> {
                 sha.clone(),
                 CommitInfo {
                     sha: fields[0].to_string(),
+                    dirty: None,
                     time: fields[1].parse().unwrap_or(0),
                     date: fields[2].to_string(),
                     parent: fields[3].split_whitespace().next().map(str::to_string),

@@ -14,12 +14,39 @@ pub mod steps;
 pub mod store;
 pub mod timeline;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-/// Where the store lives unless `--store` or [`STORE_ENV`] says otherwise: `history/` in the
-/// current directory (not reports/, which a run replaces whole).
+/// Where the store lives unless `--store` or [`STORE_ENV`] says otherwise, relative to the current
+/// directory (not to the checkout the harness was built in: an installed harness, or one built in
+/// another worktree, keeps the history of the project it is run in). `history/`, not reports/,
+/// which a run replaces whole.
+pub const DEFAULT_STORE: &str = "history/history.sqlite";
+
+/// [`DEFAULT_STORE`] as a path.
 pub fn default_store() -> PathBuf {
-    crate::paths::current_dir_join("history/history.sqlite")
+    PathBuf::from(DEFAULT_STORE)
+}
+
+/// The git repository whose commits `history run`, `find`, `show` and `forget` work on: `repo`
+/// (`--repo`) when given, else the one holding the current directory; an error that says which,
+/// and names `--repo`, when it is not in one.
+pub fn repository(repo: Option<&Path>) -> Result<PathBuf, HistoryError> {
+    match repo {
+        Some(dir) => git::repository_root(dir).map_err(|e| {
+            HistoryError::Usage(format!("--repo {}: not in a git repository ({e})", dir.display()))
+        }),
+        None => {
+            let cwd = std::env::current_dir()
+                .map_err(|e| HistoryError::Usage(format!("cannot read the current directory: {e}")))?;
+            git::repository_root(&cwd).map_err(|e| {
+                HistoryError::Usage(format!(
+                    "the current directory {} is not in a git repository: run from a checkout of the \
+                     project, or give --repo PATH ({e})",
+                    cwd.display()
+                ))
+            })
+        }
+    }
 }
 
 /// Environment variable naming the store.
@@ -30,6 +57,8 @@ pub const STORE_ENV: &str = "DEFORMBENCH_HISTORY";
 pub enum HistoryError {
     #[error("{}: not a usable history store: {detail}. It is left as it is: move it away, or give another --store", path.display())]
     Corrupt { path: PathBuf, detail: String },
+    #[error("{}: cannot be the history store: {reason}; nothing was written", path.display())]
+    Unusable { path: PathBuf, reason: String },
     #[error("{}: no history store here (`harness history record REPORTS` or `harness history run A..B` makes one)", path.display())]
     NoStore { path: PathBuf },
     #[error("{}: refused, this run would mix series: {}. Give --allow-mixed to keep it on timelines of its own", path.display(), conflicts.join("; "))]

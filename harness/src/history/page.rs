@@ -62,6 +62,16 @@ pub fn short_subject(subject: &str) -> String {
     }
 }
 
+/// How many points the timelines have: `12 commits`, or `12 commits and 2 uncommitted changes`.
+pub fn points_text(history: &History) -> String {
+    let changes = history.commits.iter().filter(|c| c.dirty.is_some()).count();
+    let commits = history.commits.len() - changes;
+    match changes {
+        0 => format!("{commits} commits"),
+        n => format!("{commits} commits and {n} uncommitted change(s)"),
+    }
+}
+
 /// One line on a step of `t`: where, how much, which commit.
 pub fn step_line(history: &History, t: &Timeline, s: &AttributedStep) -> String {
     let [measure, before, after, change, commit] = step_texts(history, t, s);
@@ -76,11 +86,11 @@ fn step_texts(history: &History, t: &Timeline, s: &AttributedStep) -> [String; 5
 /// The commit a step is named with: the commit that made it, or the range it lies in.
 pub fn step_commit(history: &History, step: &AttributedStep) -> String {
     match step.made_by {
-        Some(c) => format!("{} {}", history.commits[c].short(), short_subject(&history.commits[c].subject)),
+        Some(c) => format!("{} {}", history.commits[c].label(), short_subject(&history.commits[c].subject)),
         None => format!(
             "between {} and {} (`harness history find` narrows it)",
-            history.commits[step.from].short(),
-            history.commits[step.to].short()
+            history.commits[step.from].label(),
+            history.commits[step.to].label()
         ),
     }
 }
@@ -147,10 +157,11 @@ fn render(history: &History, store: &Path, sections: &str) -> String {
     );
     let _ = writeln!(
         page,
-        "<p>{} commits, {} series, {} timelines from <code>{}</code>. A step is a change of the fitted level \
+        "<p>{}, {} series, {} timelines from <code>{}</code>. A step is a change of the fitted level \
          (piecewise-constant fit, each point weighed by its spread or the measure's noise floor), named with the \
-         commit that made it when the commits on either side are parent and child.</p>",
-        history.commits.len(),
+         commit that made it when the commits on either side are parent and child (or a commit and an uncommitted \
+         change of it, <code>+dirty:</code> and the first digits of its diff's SHA-256).</p>",
+        escape(&points_text(history)),
         history.series.len(),
         history.timelines.len(),
         escape(&store.display().to_string())
@@ -180,7 +191,7 @@ fn render(history: &History, store: &Path, sections: &str) -> String {
                 escape(&c.method),
                 escape(&c.before),
                 escape(&c.after),
-                escape(history.commits[c.to].short())
+                escape(&history.commits[c.to].label())
             );
         }
         page.push_str("</table>\n");
@@ -197,7 +208,7 @@ fn render(history: &History, store: &Path, sections: &str) -> String {
         let _ = writeln!(
             page,
             "<tr><td>{i}</td><td><code>{}</code></td><td>{}</td><td>{changed}</td><td>{made}</td><td>{}</td></tr>",
-            c.short(),
+            c.label(),
             escape(&c.date),
             escape(&short_subject(&c.subject))
         );

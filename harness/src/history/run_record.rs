@@ -19,6 +19,9 @@ pub struct RunRecord {
     pub commit: String,
     /// Whether its tree differed from the commit.
     pub dirty: bool,
+    /// When dirty, the SHA-256 of the uncommitted change (`provenance.build.git_diff_sha256`, from
+    /// issue 60 on; `None` before): runs of one commit with other changes are other points.
+    pub diff: Option<String>,
     pub started_utc: String,
     /// What a series must share to be one timeline: data source and machine class.
     pub series: SeriesKey,
@@ -90,6 +93,7 @@ pub fn parse_run(bytes: &[u8]) -> Result<RunRecord, String> {
     let commit = text(build, "git_commit")
         .ok_or("provenance.build.git_commit is missing: not run from a git checkout")?;
     let dirty = build.get("git_dirty").and_then(Value::as_bool).unwrap_or(false);
+    let diff = text(build, "git_diff_sha256").filter(|_| dirty);
     let machine = provenance.get("machine").ok_or("provenance without machine")?;
     let run = provenance.get("run").ok_or("provenance without run")?;
     let count = |v: &Value, key: &str| v.get(key).and_then(Value::as_u64).unwrap_or(0) as usize;
@@ -111,6 +115,7 @@ pub fn parse_run(bytes: &[u8]) -> Result<RunRecord, String> {
         digest: hex(&Sha256::digest(bytes)),
         commit,
         dirty,
+        diff,
         started_utc: text(run, "started_utc").unwrap_or_default(),
         series: SeriesKey { data_source: data_source_kind(&data_source), machine_class },
         data_files: data_files(provenance.get("inputs")),
@@ -118,6 +123,19 @@ pub fn parse_run(bytes: &[u8]) -> Result<RunRecord, String> {
         provenance: provenance.to_string(),
         cases,
     })
+}
+
+/// The point of a timeline a run of `commit` belongs to, for people: the commit's first `digits`
+/// hex digits, and for a run of a dirty tree `+dirty:` and the first 6 of its diff's hash
+/// (`abc1234+dirty:1a2b3c`; `+dirty` alone when the run did not record one). Runs of one commit
+/// with the same change are one point; with another change, or none, another.
+pub fn point_label(commit: &str, digits: usize, dirty: Option<&str>) -> String {
+    let commit = &commit[..commit.len().min(digits)];
+    match dirty {
+        None => commit.to_string(),
+        Some("") => format!("{commit}+dirty"),
+        Some(diff) => format!("{commit}+dirty:{}", &diff[..diff.len().min(6)]),
+    }
 }
 
 /// What data a run read, from results.json's `data_source` line ("survey data from DIR for 8

@@ -95,6 +95,9 @@ pub enum Recorded {
 pub struct StoredRun {
     pub id: i64,
     pub commit: String,
+    /// `None` for a run of the commit's own tree; for a dirty tree the SHA-256 of its change
+    /// ([`RunRecord::diff`], kept in the provenance), or `""` when the run did not record one.
+    pub dirty: Option<String>,
     pub started_utc: String,
     pub series: String,
     pub repetitions: usize,
@@ -126,20 +129,71 @@ pub struct Failure {
 pub struct HistoryStore {
     conn: Connection,
     path: PathBuf,
+    /// What [`HistoryStore::open_or_create`] made (the file, or the first directory it made).
+    made: Option<PathBuf>,
 }
 
 impl HistoryStore {
-    /// Open the store at `path`, creating it (and its directory) if there is none.
+    /// Open the store at `path`, creating it (and its directory) if there is none. A path that
+    /// cannot be a store (a directory, a directory that cannot be made, a file that cannot be
+    /// created or written) is an error naming it and the reason, and leaves nothing behind.
     pub fn open_or_create(path: &Path) -> Result<HistoryStore, HistoryError> {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .map_err(|error| HistoryError::Io { path: dir.to_path_buf(), error })?;
+        let unusable = |reason: String| HistoryError::Unusable { path: path.to_path_buf(), reason };
+        if path.is_dir() {
+            return Err(unusable(
+                "it is a directory (give the store's file, e.g. DIR/history.sqlite)".into(),
+            ));
         }
-        Self::open_with(path, true)
+        // What this call made, removed again if the store cannot be opened after all.
+        let mut made: Option<PathBuf> = None;
+        if !path.exists() {
+            let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            if !dir.exists() {
+                made = dir
+                    .ancestors()
+                    .take_while(|d| !d.as_os_str().is_empty() && !d.exists())
+                    .last()
+                    .map(Path::to_path_buf);
+                std::fs::create_dir_all(dir).map_err(|e| {
+                    unusable(format!("cannot create directory {}: {}", dir.display(), io_reason(&e)))
+                })?;
+            } else if !dir.is_dir() {
+                return Err(unusable(format!("{} is not a directory", dir.display())));
+            }
+            // Made here rather than by SQLite, whose error ("unable to open database file") does not
+            // say why.
+            std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(path)
+                .map_err(|e| unusable(format!("cannot create it in {}: {}", dir.display(), io_reason(&e))))?;
+            made.get_or_insert_with(|| path.to_path_buf());
+        } else if let Err(e) = std::fs::OpenOptions::new().read(true).write(true).open(path) {
+            return Err(unusable(format!("cannot open it for writing: {}", io_reason(&e))));
+        }
+        match Self::open_with(path, true) {
+            Ok(store) => Ok(HistoryStore { made, ..store }),
+            Err(e) => {
+                if let Some(made) = made {
+                    let _ = if made.is_dir() {
+                        std::fs::remove_dir_all(&made)
+                    } else {
+                        std::fs::remove_file(&made)
+                    };
+                }
+                Err(e)
+            }
+        }
     }
 
     /// Open the store at `path`; an error if there is none.
     pub fn open_existing(path: &Path) -> Result<HistoryStore, HistoryError> {
+        if path.is_dir() {
+            return Err(HistoryError::Unusable {
+                path: path.to_path_buf(),
+                reason: "it is a directory (give the store's file, e.g. DIR/history.sqlite)".into(),
+            });
+        }
         if !path.is_file() {
             return Err(HistoryError::NoStore { path: path.to_path_buf() });
         }
@@ -181,7 +235,7 @@ impl HistoryStore {
             return Err(corrupt(format!("SQLite's quick_check: {check}")));
         }
         conn.execute_batch("PRAGMA foreign_keys = ON;").map_err(sql)?;
-        Ok(HistoryStore { conn, path: path.to_path_buf() })
+        Ok(HistoryStore { conn, path: path.to_path_buf(), made: None })
     }
 
     fn sql(&self) -> impl Fn(rusqlite::Error) -> HistoryError + '_ {
@@ -207,114 +261,41 @@ impl HistoryStore {
         request: Option<&str>,
     ) -> Result<Recorded, HistoryError> {
         let path = self.path.clone();
-        let sql = move |error| HistoryError::Sqlite { path: path.clone(), error };
-        if let Some(id) = self
-            .conn
-            .query_row("SELECT id FROM runs WHERE digest = ?1", [&run.digest], |r| r.get::<_, i64>(0))
-            .optional()
-            .map_err(&sql)?
-        {
-            return Ok(Recorded::AlreadyThere { run: id });
-        }
-        let series = self.series_for(run, mixing)?;
-        let tx = self.conn.transaction().map_err(&sql)?;
-        tx.execute(
-            "INSERT INTO runs (digest, git_commit, dirty, started_utc, recorded_utc, data_source, machine_class, series,
-                               repetitions, data_files, provenance, source, request)
-             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)",
-            params![
-                run.digest,
-                run.commit,
-                run.dirty,
-                run.started_utc,
-                crate::provenance::utc_timestamp(std::time::SystemTime::now()),
-                run.series.data_source,
-                run.series.machine_class,
-                series,
-                run.repetitions as i64,
-                serde_json::to_string(&run.data_files).unwrap_or_default(),
-                run.provenance,
-                source,
-                request,
-            ],
-        )
-        .map_err(&sql)?;
-        let id = tx.last_insert_rowid();
-        let mut measurements = 0;
-        {
-            let mut case = tx
-                .prepare("INSERT INTO cases (run, scenario, method, status) VALUES (?1, ?2, ?3, ?4)")
-                .map_err(&sql)?;
-            let mut value = tx
-                .prepare(
-                    "INSERT INTO measurements (run, scenario, method, measure, value, low, high)
-                     VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
-                )
-                .map_err(&sql)?;
-            for c in &run.cases {
-                case.execute(params![id, c.scenario, c.method, c.status]).map_err(|e| {
-                    HistoryError::Results {
-                        path: PathBuf::from(source),
-                        message: format!("case {} / {}: {e} (named twice?)", c.scenario, c.method),
-                    }
-                })?;
-                for v in &c.values {
-                    value
-                        .execute(params![id, c.scenario, c.method, v.measure.key(), v.value, v.low, v.high])
-                        .map_err(&sql)?;
-                    measurements += 1;
-                }
-            }
-        }
-        tx.commit().map_err(&sql)?;
-        Ok(Recorded::Added { run: id, cases: run.cases.len(), measurements })
+        let sql = |error| HistoryError::Sqlite { path: path.clone(), error };
+        let tx = self.conn.transaction().map_err(sql)?;
+        let recorded = insert_run(&tx, &path, run, source, mixing, request)?;
+        tx.commit().map_err(sql)?;
+        Ok(recorded)
     }
 
-    /// The series `run` joins: its own label, unless the store holds runs of another series or
-    /// other data files of the same name, which only [`Mixing::Allow`] lets in (then on timelines
-    /// of their own, the label saying why).
-    fn series_for(&self, run: &RunRecord, mixing: Mixing) -> Result<String, HistoryError> {
-        let mut label = run.series.label();
-        let mut stmt = self
-            .conn
-            .prepare("SELECT DISTINCT data_source, machine_class, data_files FROM runs")
-            .map_err(self.sql())?;
-        let stored: Vec<(String, String, String)> = stmt
-            .query_map([], |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?)))
-            .map_err(self.sql())?
-            .collect::<Result<_, _>>()
-            .map_err(self.sql())?;
-        let mut conflicts = Vec::new();
-        for (data_source, machine_class, files) in &stored {
-            let key = SeriesKey { data_source: data_source.clone(), machine_class: machine_class.clone() };
-            if key != run.series {
-                conflicts.push(format!(
-                    "the store holds {}; this run is {}",
-                    key.label(),
-                    run.series.label()
-                ));
-                continue;
-            }
-            let files: BTreeMap<String, String> = serde_json::from_str::<Vec<(String, String)>>(files)
-                .unwrap_or_default()
-                .into_iter()
-                .collect();
-            for (name, sha) in &run.data_files {
-                if files.get(name).is_some_and(|s| s != sha) {
-                    conflicts.push(format!(
-                        "data file {name} differs from the store's ({} against {})",
-                        &sha[..sha.len().min(12)],
-                        &files[name][..files[name].len().min(12)]
-                    ));
-                    label = format!("{label}, other {name}");
-                }
-            }
-        }
-        conflicts.sort();
-        conflicts.dedup();
-        match (conflicts.is_empty(), mixing) {
-            (true, _) | (false, Mixing::Allow) => Ok(label),
-            (false, Mixing::Refuse) => Err(HistoryError::Mixed { path: self.path.clone(), conflicts }),
+    /// Store every one of `runs` (each with the file it was read from), or none of them: one
+    /// transaction, in which each run is judged against the store and the runs before it (two runs
+    /// of one call that would mix series are refused as one run would be). The first refusal is the
+    /// error; it names the run's file.
+    pub fn record_all(
+        &mut self,
+        runs: &[(&RunRecord, String)],
+        mixing: Mixing,
+    ) -> Result<Vec<Recorded>, HistoryError> {
+        let path = self.path.clone();
+        let sql = |error| HistoryError::Sqlite { path: path.clone(), error };
+        let tx = self.conn.transaction().map_err(sql)?;
+        let recorded = runs
+            .iter()
+            .map(|(run, source)| insert_run(&tx, &path, run, source, mixing, None))
+            .collect::<Result<Vec<_>, _>>()?;
+        tx.commit().map_err(sql)?;
+        Ok(recorded)
+    }
+
+    /// Close the store, removing it (and the directories made for it) when this call to
+    /// [`HistoryStore::open_or_create`] made it: for a command that ends in an error and must leave
+    /// nothing behind.
+    pub fn abandon(self) {
+        let HistoryStore { conn, made, .. } = self;
+        drop(conn);
+        if let Some(made) = made {
+            let _ = if made.is_dir() { std::fs::remove_dir_all(&made) } else { std::fs::remove_file(&made) };
         }
     }
 
@@ -322,13 +303,23 @@ impl HistoryStore {
     pub fn runs(&self) -> Result<Vec<StoredRun>, HistoryError> {
         let mut stmt = self
             .conn
-            .prepare("SELECT id, git_commit, started_utc, series, repetitions, source FROM runs ORDER BY id")
+            .prepare(
+                "SELECT id, git_commit, started_utc, series, repetitions, source, dirty, provenance FROM runs ORDER BY id",
+            )
             .map_err(self.sql())?;
         let rows = stmt
             .query_map([], |r| {
+                let dirty = r.get::<_, bool>(6)?.then(|| {
+                    let provenance: String = r.get(7).unwrap_or_default();
+                    serde_json::from_str::<serde_json::Value>(&provenance)
+                        .ok()
+                        .and_then(|p| p["build"]["git_diff_sha256"].as_str().map(str::to_string))
+                        .unwrap_or_default()
+                });
                 Ok(StoredRun {
                     id: r.get(0)?,
                     commit: r.get(1)?,
+                    dirty,
                     started_utc: r.get(2)?,
                     series: r.get(3)?,
                     repetitions: r.get::<_, i64>(4)? as usize,
@@ -407,16 +398,49 @@ impl HistoryStore {
     /// run spoiled by something outside it (a loaded machine), before running the commit again.
     /// Returns the runs removed.
     pub fn forget(&mut self, commit: &str) -> Result<usize, HistoryError> {
+        Ok(self.forget_all(&[commit.to_string()])?[0])
+    }
+
+    /// [`HistoryStore::forget`] of each of `commits`, in one transaction; the runs removed of each.
+    pub fn forget_all(&mut self, commits: &[String]) -> Result<Vec<usize>, HistoryError> {
         let path = self.path.clone();
         let sql = move |error| HistoryError::Sqlite { path: path.clone(), error };
         let tx = self.conn.transaction().map_err(&sql)?;
-        let runs = "SELECT id FROM runs WHERE git_commit = ?1";
-        tx.execute(&format!("DELETE FROM measurements WHERE run IN ({runs})"), [commit]).map_err(&sql)?;
-        tx.execute(&format!("DELETE FROM cases WHERE run IN ({runs})"), [commit]).map_err(&sql)?;
-        let removed = tx.execute("DELETE FROM runs WHERE git_commit = ?1", [commit]).map_err(&sql)?;
-        tx.execute("DELETE FROM failures WHERE git_commit = ?1", [commit]).map_err(&sql)?;
+        let mut removed = Vec::new();
+        for commit in commits {
+            let runs = "SELECT id FROM runs WHERE git_commit = ?1";
+            tx.execute(&format!("DELETE FROM measurements WHERE run IN ({runs})"), [commit]).map_err(&sql)?;
+            tx.execute(&format!("DELETE FROM cases WHERE run IN ({runs})"), [commit]).map_err(&sql)?;
+            removed.push(tx.execute("DELETE FROM runs WHERE git_commit = ?1", [commit]).map_err(&sql)?);
+            tx.execute("DELETE FROM failures WHERE git_commit = ?1", [commit]).map_err(&sql)?;
+        }
         tx.commit().map_err(&sql)?;
         Ok(removed)
+    }
+
+    /// Every commit the store holds runs or failures of: full hash -> (runs, failures).
+    pub fn stored_commits(&self) -> Result<BTreeMap<String, (usize, usize)>, HistoryError> {
+        let mut out: BTreeMap<String, (usize, usize)> = BTreeMap::new();
+        for (table, failures) in [("runs", false), ("failures", true)] {
+            let mut stmt = self
+                .conn
+                .prepare(&format!("SELECT git_commit, count(*) FROM {table} GROUP BY git_commit"))
+                .map_err(self.sql())?;
+            let rows = stmt
+                .query_map([], |r| Ok((r.get::<_, String>(0)?, r.get::<_, i64>(1)? as usize)))
+                .map_err(self.sql())?
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(self.sql())?;
+            for (commit, n) in rows {
+                let entry = out.entry(commit).or_default();
+                if failures {
+                    entry.1 = n;
+                } else {
+                    entry.0 = n;
+                }
+            }
+        }
+        Ok(out)
     }
 
     /// Keep that `commit` failed at `stage` for its request (replacing an earlier failure).
@@ -457,6 +481,128 @@ impl HistoryStore {
             .collect::<Result<Vec<_>, _>>()
             .map_err(self.sql())?;
         Ok(rows)
+    }
+}
+
+/// Insert `run` (read from `source`) through `conn` (a transaction), unless it is there already.
+fn insert_run(
+    conn: &Connection,
+    path: &Path,
+    run: &RunRecord,
+    source: &str,
+    mixing: Mixing,
+    request: Option<&str>,
+) -> Result<Recorded, HistoryError> {
+    let sql = |error| HistoryError::Sqlite { path: path.to_path_buf(), error };
+    if let Some(id) = conn
+        .query_row("SELECT id FROM runs WHERE digest = ?1", [&run.digest], |r| r.get::<_, i64>(0))
+        .optional()
+        .map_err(sql)?
+    {
+        return Ok(Recorded::AlreadyThere { run: id });
+    }
+    let series = series_for(conn, path, run, source, mixing)?;
+    conn.execute(
+        "INSERT INTO runs (digest, git_commit, dirty, started_utc, recorded_utc, data_source, machine_class, series,
+                           repetitions, data_files, provenance, source, request)
+         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)",
+        params![
+            run.digest,
+            run.commit,
+            run.dirty,
+            run.started_utc,
+            crate::provenance::utc_timestamp(std::time::SystemTime::now()),
+            run.series.data_source,
+            run.series.machine_class,
+            series,
+            run.repetitions as i64,
+            serde_json::to_string(&run.data_files).unwrap_or_default(),
+            run.provenance,
+            source,
+            request,
+        ],
+    )
+    .map_err(sql)?;
+    let id = conn.last_insert_rowid();
+    let mut measurements = 0;
+    let mut case = conn
+        .prepare("INSERT INTO cases (run, scenario, method, status) VALUES (?1, ?2, ?3, ?4)")
+        .map_err(sql)?;
+    let mut value = conn
+        .prepare(
+            "INSERT INTO measurements (run, scenario, method, measure, value, low, high)
+             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
+        )
+        .map_err(sql)?;
+    for c in &run.cases {
+        case.execute(params![id, c.scenario, c.method, c.status]).map_err(|e| HistoryError::Results {
+            path: PathBuf::from(source),
+            message: format!("case {} / {}: {e} (named twice?)", c.scenario, c.method),
+        })?;
+        for v in &c.values {
+            value
+                .execute(params![id, c.scenario, c.method, v.measure.key(), v.value, v.low, v.high])
+                .map_err(sql)?;
+            measurements += 1;
+        }
+    }
+    Ok(Recorded::Added { run: id, cases: run.cases.len(), measurements })
+}
+
+/// The series `run` (read from `source`) joins: its own label, unless the store holds runs of
+/// another series or other data files of the same name, which only [`Mixing::Allow`] lets in (then
+/// on timelines of their own, the label saying why). A refusal names `source`.
+fn series_for(
+    conn: &Connection,
+    path: &Path,
+    run: &RunRecord,
+    source: &str,
+    mixing: Mixing,
+) -> Result<String, HistoryError> {
+    let sql = |error| HistoryError::Sqlite { path: path.to_path_buf(), error };
+    let mut label = run.series.label();
+    let mut stmt =
+        conn.prepare("SELECT DISTINCT data_source, machine_class, data_files FROM runs").map_err(sql)?;
+    let stored: Vec<(String, String, String)> = stmt
+        .query_map([], |r| Ok((r.get(0)?, r.get(1)?, r.get(2)?)))
+        .map_err(sql)?
+        .collect::<Result<_, _>>()
+        .map_err(sql)?;
+    let mut conflicts = Vec::new();
+    for (data_source, machine_class, files) in &stored {
+        let key = SeriesKey { data_source: data_source.clone(), machine_class: machine_class.clone() };
+        if key != run.series {
+            conflicts.push(format!("the store holds {}; this run is {}", key.label(), run.series.label()));
+            continue;
+        }
+        let files: BTreeMap<String, String> =
+            serde_json::from_str::<Vec<(String, String)>>(files).unwrap_or_default().into_iter().collect();
+        for (name, sha) in &run.data_files {
+            if files.get(name).is_some_and(|s| s != sha) {
+                conflicts.push(format!(
+                    "data file {name} differs from the store's ({} against {})",
+                    &sha[..sha.len().min(12)],
+                    &files[name][..files[name].len().min(12)]
+                ));
+                label = format!("{label}, other {name}");
+            }
+        }
+    }
+    conflicts.sort();
+    conflicts.dedup();
+    match (conflicts.is_empty(), mixing) {
+        (true, _) | (false, Mixing::Allow) => Ok(label),
+        (false, Mixing::Refuse) => Err(HistoryError::Mixed { path: PathBuf::from(source), conflicts }),
+    }
+}
+
+/// An I/O error's reason in the words of a sentence (`permission denied (os error 13)`).
+fn io_reason(e: &std::io::Error) -> String {
+    let text = e.to_string();
+    let mut chars = text.chars();
+    match chars.next() {
+        Some(first) => first.to_lowercase().chain(chars).collect(),
+        None => text,
     }
 }
 

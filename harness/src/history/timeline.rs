@@ -12,7 +12,7 @@ use super::steps::{self, Observation};
 use super::store::HistoryStore;
 use super::HistoryError;
 
-/// One point: a commit's value of the measure.
+/// One point: a commit's value of the measure (or an uncommitted change's, [`CommitInfo::dirty`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Point {
     /// Index into [`History::commits`].
@@ -37,7 +37,8 @@ pub struct AttributedStep {
     pub after: f64,
     /// `after / before - 1`.
     pub relative: f64,
-    /// The commit that made it: `to`, when `from` is its first parent.
+    /// The commit that made it: `to`, when it follows `from` ([`CommitInfo::follows`]: `from` is its
+    /// first parent, or `to` is an uncommitted change of `from`).
     pub made_by: Option<usize>,
 }
 
@@ -57,7 +58,8 @@ pub struct Timeline {
 /// Every timeline of a store, over its commits.
 #[derive(Clone, Debug)]
 pub struct History {
-    /// The stored commits in the repository's order (oldest first).
+    /// The stored commits in the repository's order (oldest first); runs of a dirty tree are
+    /// points of their own, after their commit ([`CommitInfo::dirty`]).
     pub commits: Vec<CommitInfo>,
     /// Whether each commit changed method code ([`git::touches_methods`]) since the commit before it
     /// in `commits`; `None` where git cannot tell.
@@ -86,50 +88,68 @@ fn status_kind(status: &str) -> &str {
 }
 
 /// Build every timeline of `store`, ordering commits by `repo`'s history (by commit time where
-/// git does not know them, then by record).
+/// git does not know them, then by record). Runs of one commit are one point, and runs of its tree
+/// with an uncommitted change another for each change (its diff's hash), after the commit.
 pub fn build(store: &HistoryStore, repo: &Path) -> Result<History, HistoryError> {
     let runs = store.runs()?;
+    // A point: (commit, diff of a dirty tree).
+    type PointKey = (String, Option<String>);
     let mut shas: Vec<String> = Vec::new();
+    let mut keys: Vec<PointKey> = Vec::new();
     for r in &runs {
         if !shas.contains(&r.commit) {
             shas.push(r.commit.clone());
         }
+        let key = (r.commit.clone(), r.dirty.clone());
+        if !keys.contains(&key) {
+            keys.push(key);
+        }
     }
     let infos = git::infos(repo, &shas);
     let order = git::topological_order(repo);
-    let first_record: HashMap<&str, usize> =
-        runs.iter().enumerate().rev().map(|(i, r)| (r.commit.as_str(), i)).collect();
-    shas.sort_by_key(|s| {
+    // Runs are in record order, so the first run of each key is its first record.
+    let first_record: HashMap<PointKey, usize> =
+        runs.iter().enumerate().rev().map(|(i, r)| ((r.commit.clone(), r.dirty.clone()), i)).collect();
+    keys.sort_by_key(|k| {
         (
-            order.get(s).copied().unwrap_or(usize::MAX),
-            infos.get(s).map_or(i64::MAX, |i| i.time),
-            first_record[s.as_str()],
+            order.get(&k.0).copied().unwrap_or(usize::MAX),
+            infos.get(&k.0).map_or(i64::MAX, |i| i.time),
+            k.1.is_some(),
+            first_record[k],
         )
     });
-    let commits: Vec<CommitInfo> = shas
+    let commits: Vec<CommitInfo> = keys
         .iter()
-        .map(|s| {
-            infos.get(s).cloned().unwrap_or(CommitInfo {
+        .map(|(s, dirty)| {
+            let info = infos.get(s).cloned().unwrap_or(CommitInfo {
                 sha: s.clone(),
+                dirty: None,
                 time: 0,
                 date: String::new(),
                 subject: "(not in this repository)".into(),
                 parent: None,
-            })
+            });
+            CommitInfo { dirty: dirty.clone(), ..info }
         })
         .collect();
-    let index: HashMap<&str, usize> = shas.iter().enumerate().map(|(i, s)| (s.as_str(), i)).collect();
+    let index: HashMap<&PointKey, usize> = keys.iter().enumerate().map(|(i, k)| (k, i)).collect();
     let method_change: Vec<Option<bool>> = commits
         .iter()
         .enumerate()
         .map(|(i, c)| {
+            // Which files an uncommitted change touched is not in git.
+            if c.dirty.is_some() {
+                return None;
+            }
             let before = if i == 0 { c.parent.clone()? } else { commits[i - 1].sha.clone() };
             git::changed_files(repo, &before, &c.sha).ok().map(|f| git::touches_methods(&f))
         })
         .collect();
 
-    let run_of: HashMap<i64, (usize, &str)> =
-        runs.iter().map(|r| (r.id, (index[r.commit.as_str()], r.series.as_str()))).collect();
+    let run_of: HashMap<i64, (usize, &str)> = runs
+        .iter()
+        .map(|r| (r.id, (index[&(r.commit.clone(), r.dirty.clone())], r.series.as_str())))
+        .collect();
     let statuses = store.statuses()?;
     // (series, scenario, method, measure) -> commit -> values (value, low, high, run id)
     type Key = (String, String, String, Measure);
@@ -169,7 +189,7 @@ pub fn build(store: &HistoryStore, repo: &Path) -> Result<History, HistoryError>
             .into_iter()
             .map(|s| {
                 let (from, to) = (points[s.at - 1].commit, points[s.at].commit);
-                let adjacent = commits[to].parent.as_deref() == Some(commits[from].sha.as_str());
+                let adjacent = commits[to].follows(&commits[from]);
                 AttributedStep {
                     from,
                     to,

@@ -68,13 +68,15 @@ fn summary_line(comparison: &Comparison) -> String {
     let t = comparison.tally();
     format!(
         "{} cases in both runs: {} slower, {} faster, {} same within noise, {} not judged (the total time, \
-         precompute + bind + solve; slower or faster only when the min–max ranges do not overlap and the medians \
-         differ by {:.0}% or more); quality: {} worse, {} better (the gate's tolerances, A as the baseline).",
+         precompute + bind + solve; slower or faster only when the min–max ranges, each widened to at least {:.0} ms, \
+         do not overlap and the medians differ by {:.0}% or more); quality: {} worse, {} better (the gate's \
+         tolerances, A as the baseline).",
         comparison.cases.len(),
         t.slower,
         t.faster,
         t.same,
         t.not_judged,
+        1e3 * crate::comparison::NOISE_FLOOR_S,
         100.0 * comparison.min_change,
         t.worse,
         t.better
@@ -85,6 +87,9 @@ fn summary_line(comparison: &Comparison) -> String {
 pub fn render_markdown(comparison: &Comparison) -> String {
     let mut md = String::new();
     let _ = writeln!(md, "# B against A\n");
+    if comparison.same_commit_and_inputs {
+        let _ = writeln!(md, "{}\n", crate::comparison::SAME_COMMIT_AND_INPUTS);
+    }
     let _ = writeln!(md, "- A: `{}`: {}", comparison.a.display(), comparison.a_record);
     let _ = writeln!(md, "- B: `{}`: {}\n", comparison.b.display(), comparison.b_record);
     for w in &comparison.warnings {
@@ -132,8 +137,12 @@ pub fn render_html(comparison: &Comparison) -> String {
         "tr.slower td.speed{background:#fdd}tr.faster td.speed{background:#dfd}\n",
         "tr.worse td.quality{background:#fdd}tr.better td.quality{background:#dfd}\n",
         "p.warning{background:#fff1d6;padding:.4em .7em;border-left:4px solid #d90}\n",
+        "p.same{font-weight:bold}\n",
         "</style>\n</head>\n<body>\n<h1>B against A</h1>\n"
     ));
+    if comparison.same_commit_and_inputs {
+        let _ = writeln!(page, "<p class=\"same\">{}</p>", crate::comparison::SAME_COMMIT_AND_INPUTS);
+    }
     let _ = writeln!(
         page,
         "<ul><li>A: <code>{}</code>: {}</li><li>B: <code>{}</code>: {}</li></ul>",
