@@ -70,14 +70,16 @@ enum Command {
         #[arg(long)]
         sweeps: bool,
     },
-    /// Run chosen methods on one scenario and print the results (writes reports/ like `all`).
+    /// Run chosen methods on chosen scenarios and print the results (writes reports/ like `all`).
     Run {
-        /// Method name (repeatable; see `list`).
-        #[arg(long = "method", required = true)]
+        /// Method name (repeatable; see `list`). Without it each scenario runs the methods its
+        /// `methods = [...]` lists; a scenario that lists none is then an error naming it (give
+        /// --method, or run every method with `all --scenarios DIR`).
+        #[arg(long = "method")]
         methods: Vec<String>,
-        /// Scenario name (see `list`), or the path of a scenario file.
-        #[arg(long)]
-        scenario: String,
+        /// Scenario name (see `list`), or the path of a scenario file (repeatable).
+        #[arg(long = "scenario", required = true)]
+        scenarios: Vec<String>,
         #[command(flatten)]
         common: Common,
         #[command(flatten)]
@@ -369,8 +371,11 @@ where
             let publish = PublishOptions { peer_python: None, meshes: meshes.output() };
             publish_and_print(&staged_options, staging, run, &publish, gate)
         }
-        Command::Run { methods, scenario, common, peers, meshes } => {
-            let mut options = common.options(vec![scenario], methods, &command_line);
+        Command::Run { methods, scenarios, common, peers, meshes } => {
+            let mut options = common.options(scenarios, methods, &command_line);
+            if options.methods.is_empty() {
+                suite::require_listed_methods(&options)?;
+            }
             options.python = peers.python_path();
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
@@ -383,7 +388,7 @@ where
                 staging,
                 run,
                 &publish,
-                GateRequest::Skip("`run` covers one scenario".to_string()),
+                GateRequest::Skip("`run` covers chosen scenarios and methods".to_string()),
             )
         }
         Command::Check { common, gate } => {

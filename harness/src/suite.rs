@@ -221,6 +221,27 @@ pub fn load_catalog(options: &SuiteOptions) -> Result<MethodCatalog, HarnessErro
     Ok(catalog)
 }
 
+/// `run` without `--method` runs each scenario's own `methods = [...]`: an error naming every
+/// selected scenario that lists none (rather than running every method on it, which is `all`'s
+/// job), and saying what to give instead.
+pub fn require_listed_methods(options: &SuiteOptions) -> Result<(), HarnessError> {
+    let specs = select_specs(options)?;
+    let without: Vec<String> = specs
+        .iter()
+        .filter(|s| s.methods.is_none())
+        .map(|s| format!("`{}` ({})", s.name, s.path.display()))
+        .collect();
+    if without.is_empty() {
+        return Ok(());
+    }
+    Err(HarnessError::Report(format!(
+        "no --method given, and scenario {} lists no `methods = [...]`: give --method NAME (repeatable; \
+         `harness list` shows the names), add `methods` to the scenario file, or run every method with \
+         `harness all --scenarios DIR`",
+        without.join(", ")
+    )))
+}
+
 /// The scenario files of the run: every one in the scenarios directory, or the ones named (by name, or
 /// by the path of a `.toml` file anywhere).
 fn select_specs(options: &SuiteOptions) -> Result<Vec<ScenarioSpec>, HarnessError> {
