@@ -146,20 +146,34 @@ pub fn prepare(options: &SuiteOptions) -> Result<Prepared, HarnessError> {
                 message: format!("[{m}]: cannot run here: {}", why.1),
             });
         }
-        catalog.find(m).map_err(|message| {
-            let peers = options.configs_dir.join("peers.toml");
-            let is_peer = std::fs::read_to_string(&peers).is_ok_and(|t| t.contains(&format!("[{m}]")));
-            let hint = if is_peer && options.peers.is_none() { " (a peer: add --peers)" } else { "" };
-            HarnessError::Config { path: catalog.path().to_path_buf(), message: format!("{message}{hint}") }
-        })?;
+        // The name came from the command line: the error says so, not methods.toml.
+        if let Some(message) = unknown_method(options, &catalog, m) {
+            return Err(HarnessError::Report(format!("--method {m}: {message}")));
+        }
     }
     if let Some(sweeps) = &options.sweeps {
         check_sweep_scenarios(options, &catalog, sweeps)?;
     }
     let specs = select_specs(options)?;
     for spec in &specs {
-        for m in spec.methods.iter().flatten().chain(spec.left_out.keys()) {
-            catalog.find(m).map_err(|message| HarnessError::Config { path: spec.path.clone(), message })?;
+        let named = spec
+            .methods
+            .iter()
+            .flatten()
+            .map(|m| ("methods", m))
+            .chain(spec.left_out.keys().map(|m| ("left_out", m)));
+        for (key, m) in named {
+            if let Some(message) = unknown_method(options, &catalog, m) {
+                let key = if key == "left_out" {
+                    format!("left_out.{m}")
+                } else {
+                    format!("methods = [.. \"{m}\" ..]")
+                };
+                return Err(HarnessError::Config {
+                    path: spec.path.clone(),
+                    message: format!("{key}: {message}"),
+                });
+            }
         }
     }
     let source = options.data_source()?;
@@ -171,6 +185,16 @@ pub fn prepare(options: &SuiteOptions) -> Result<Prepared, HarnessError> {
         skipped.extend(loaded.skipped);
     }
     Ok(Prepared { config: RunConfig { catalog, rules }, scenarios, skipped, source })
+}
+
+/// Why `name` is no method of `catalog` (with the nearest name, and whether it is a peer that
+/// needs `--peers`), or `None` when it is one.
+fn unknown_method(options: &SuiteOptions, catalog: &MethodCatalog, name: &str) -> Option<String> {
+    let message = catalog.find(name).err()?;
+    let peers = options.configs_dir.join("peers.toml");
+    let is_peer = std::fs::read_to_string(&peers).is_ok_and(|t| t.contains(&format!("[{name}]")));
+    let hint = if is_peer && options.peers.is_none() { " (a peer: add --peers)" } else { "" };
+    Some(format!("{message}{hint}"))
 }
 
 /// Every scenario a sweep file's `scenarios` names exists, in the run's scenario directory or the
@@ -256,7 +280,14 @@ fn select_specs(options: &SuiteOptions) -> Result<Vec<ScenarioSpec>, HarnessErro
                 let known: Vec<&str> = specs.iter().map(|s| s.name.as_str()).collect();
                 return Err(HarnessError::Scenario {
                     scenario: name.to_string(),
-                    message: format!("no such scenario in {}; known: {}", dir.display(), known.join(", ")),
+                    file: None,
+                    message: format!(
+                        "--scenario {name}: no such scenario in {}{}; known: {} (or give the path of a \
+                         scenario file)",
+                        dir.display(),
+                        crate::error::did_you_mean(name, known.iter().copied()),
+                        known.join(", ")
+                    ),
                 });
             }
         }

@@ -59,3 +59,77 @@ fn run_without_method_runs_each_scenarios_own_list() {
     assert!(err.contains("`bare`") && err.contains("bare.toml") && err.contains("--method"), "{err}");
     assert!(!err.contains("`first`"), "only the scenario without a list is named: {err}");
 }
+
+/// [`harness`] in the working directory `dir`.
+fn harness_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_harness")).current_dir(dir).args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A fixed slab at the bottom of a mesh and a handle slab at its top, moved sideways.
+const FIXED_AND_HANDLE: &str = "[[regions]]\nname = \"base\"\nrole = \"fixed\"\n\
+    select = { slab = { axis = \"z\", from = 0.0, to = 0.05 } }\n\
+    [[regions]]\nname = \"top\"\nrole = \"handle\"\nselect = { slab = { axis = \"z\", from = 0.95, to = 1.0 } }\n\
+    translate = [0.1, 0.0, 0.0]\n";
+
+#[test]
+fn a_missing_relative_mesh_names_the_scenario_file_the_key_and_the_absolute_path() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("mine")).unwrap();
+    let scenario =
+        format!("name = \"dragon\"\nmesh = \"models/dragon.ply\"\nmethods = [\"arap\"]\n{FIXED_AND_HANDLE}");
+    std::fs::write(dir.path().join("mine/dragon.toml"), scenario).unwrap();
+    // A relative scenario path from the working directory: the message still shows where it looked.
+    let (code, out, err) =
+        harness_in(dir.path(), &["run", "--quiet", "--scenario", "mine/dragon.toml", "--reports", "reports"]);
+    assert_eq!(code, 2, "{out}{err}");
+    let absolute = dir.path().canonicalize().unwrap().join("mine/models/dragon.ply");
+    for needle in [
+        "scenario `dragon`",
+        "mine/dragon.toml",
+        "mesh = \"models/dragon.ply\"",
+        &format!("{} does not exist", absolute.display()),
+    ] {
+        assert!(err.contains(needle), "{needle:?} not in {err}");
+    }
+    assert!(!dir.path().join("reports").exists(), "nothing written");
+}
+
+#[test]
+fn unknown_names_get_the_nearest_one_and_are_blamed_on_where_they_came_from() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = bar_scenario(dir.path(), "first", "methods = [\"arap\"]\n");
+    let reports = dir.path().join("reports");
+    let reports = reports.to_str().unwrap();
+    let (code, out, err) =
+        harness(&["run", "--quiet", "--scenario", &scenario, "--method", "isoline", "--reports", reports]);
+    assert_eq!(code, 2, "{out}{err}");
+    assert!(err.contains("--method isoline") && err.contains("did you mean `isolines`?"), "{err}");
+    assert!(!err.contains("methods.toml"), "the name came from the command line: {err}");
+
+    let listed = bar_scenario(dir.path(), "listed", "methods = [\"arap\", \"lapalcian\"]\n");
+    let (code, out, err) = harness(&["run", "--quiet", "--scenario", &listed, "--reports", reports]);
+    assert_eq!(code, 2, "{out}{err}");
+    for needle in ["listed.toml", "methods", "unknown method `lapalcian`", "did you mean `laplacian`?"] {
+        assert!(err.contains(needle), "{needle:?} not in {err}");
+    }
+    assert!(!err.contains("methods.toml"), "the name came from the scenario: {err}");
+
+    let left_out =
+        bar_scenario(dir.path(), "left", "methods = [\"arap\"]\n[left_out]\nscale_awar = \"too slow\"\n");
+    let (code, out, err) = harness(&["run", "--quiet", "--scenario", &left_out, "--reports", reports]);
+    assert_eq!(code, 2, "{out}{err}");
+    for needle in ["left.toml", "left_out.scale_awar", "did you mean `scale_aware`?"] {
+        assert!(err.contains(needle), "{needle:?} not in {err}");
+    }
+    assert!(!err.contains("methods.toml"), "the name came from the scenario: {err}");
+
+    let (code, out, err) =
+        harness(&["run", "--quiet", "--scenario", "cylindre", "--method", "arap", "--reports", reports]);
+    assert_eq!(code, 2, "{out}{err}");
+    assert!(err.contains("cylindre") && err.contains("did you mean `cylinder`?"), "{err}");
+}

@@ -120,6 +120,27 @@ impl PathContext {
         self.read.push(resolved.clone());
         Ok(resolved)
     }
+
+    /// `written`, the value of the scenario's key `key`, resolved as [`PathContext::resolve`] does,
+    /// when something is there. Otherwise the error names the key, the value as written and the
+    /// absolute path it resolved to (and, for a relative value, the directory it was taken from).
+    pub fn resolve_existing(&self, key: &str, written: &str) -> Result<PathBuf, String> {
+        let path = self.resolve(written).map_err(|e| format!("{key} = \"{written}\": {e}"))?;
+        if path.exists() {
+            return Ok(path);
+        }
+        let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        let relative = !Path::new(written).is_absolute() && !written.starts_with("${");
+        let from = if relative {
+            format!(
+                " (a relative path is taken from the scenario file's directory, {})",
+                absolute(&self.base).display()
+            )
+        } else {
+            String::new()
+        };
+        Err(format!("{key} = \"{written}\": {} does not exist{from}", absolute(&path).display()))
+    }
 }
 
 /// The per-vertex files a region may read, one entry per vertex of the input file.
@@ -202,7 +223,7 @@ impl Selection {
         };
         let picked: Vec<u32> = match self {
             Selection::Sel { file, status } => {
-                let path = paths.resolve(file)?;
+                let path = paths.resolve_existing("select.sel.file", file)?;
                 let codes = files.sel(&path)?;
                 let picked =
                     (0..n_input as u32).filter(|&v| codes[v as usize] == *status).collect::<Vec<_>>();
@@ -212,7 +233,7 @@ impl Selection {
                 picked
             }
             Selection::Dmat { file, id } => {
-                let path = paths.resolve(file)?;
+                let path = paths.resolve_existing("select.dmat.file", file)?;
                 let ids = files.dmat(&path)?;
                 let picked = (0..n_input as u32).filter(|&v| ids[v as usize] == *id).collect::<Vec<_>>();
                 if picked.is_empty() {
@@ -228,7 +249,7 @@ impl Selection {
             }
             Selection::Vertices(list) => checked_ids(list.clone(), n_input, "select.vertices")?,
             Selection::VertexFile(file) => {
-                let path = paths.resolve(file)?;
+                let path = paths.resolve_existing("select.vertex_file", file)?;
                 checked_ids(files.index_list(&path)?, n_input, &path.display().to_string())?
             }
             Selection::Box { min, max } => {
@@ -303,11 +324,17 @@ mod tests {
         (0..4).map(|i| [i as f64, 0.0, 0.0]).collect()
     }
 
+    /// `s` on [`line`], its files (read by [`NoFiles`]) present, empty, in a fresh directory.
     fn pick(s: &Selection, input: &InputIndex) -> Result<Vec<u32>, String> {
+        let dir = tempfile::tempdir().unwrap();
+        for file in ["x.sel", "x.dmat", "ids.txt"] {
+            std::fs::write(dir.path().join(file), "").unwrap();
+        }
+        let base = dir.path().to_path_buf();
         s.vertices(
             &line(),
             input,
-            &PathContext { base: "/data".into(), stem: Some("knight".into()), read: FilesRead::default() },
+            &PathContext { base, stem: Some("knight".into()), read: FilesRead::default() },
             &NoFiles,
         )
     }
@@ -364,5 +391,11 @@ mod tests {
         assert!(e.contains("DEFORMBENCH_TEST_UNSET_VARIABLE"), "{e}");
         let no_stem = PathContext { base: ".".into(), stem: None, read: FilesRead::default() };
         assert!(no_stem.resolve("{stem}.sel").unwrap_err().contains("needs a mesh file"));
+        let e = ctx.resolve_existing("select.dmat.file", "sel/{stem}.dmat").unwrap_err();
+        assert_eq!(
+            e,
+            "select.dmat.file = \"sel/{stem}.dmat\": /configs/real/sel/knight.dmat does not exist \
+             (a relative path is taken from the scenario file's directory, /configs/real)"
+        );
     }
 }
