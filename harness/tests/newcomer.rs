@@ -133,3 +133,90 @@ fn unknown_names_get_the_nearest_one_and_are_blamed_on_where_they_came_from() {
     assert_eq!(code, 2, "{out}{err}");
     assert!(err.contains("cylindre") && err.contains("did you mean `cylinder`?"), "{err}");
 }
+
+/// The results of `reports` as `(scenario, method) -> row`, each row its column -> value.
+fn rows(reports: &Path) -> Vec<std::collections::BTreeMap<String, String>> {
+    let mut reader = csv::Reader::from_path(reports.join("results.csv")).unwrap();
+    let headers = reader.headers().unwrap().clone();
+    reader
+        .records()
+        .map(|r| headers.iter().zip(r.unwrap().iter()).map(|(h, v)| (h.to_string(), v.to_string())).collect())
+        .collect()
+}
+
+/// `.dmat` selections of both kinds on a bar written as OFF: a per-vertex file of region ids
+/// (`id`) and an index list (`form = "indices"`) select the same handle, so both scenarios give the
+/// same result; an index list read as region ids is an error that says so and names the key.
+#[test]
+fn a_dmat_selection_reads_region_ids_or_an_index_list_and_says_which_it_looks_like() {
+    let dir = tempfile::tempdir().unwrap();
+    let bar = meshes::shapes::generate(meshes::shapes::ShapeKind::Bar, 500).unwrap().mesh;
+    meshes::io::write_off(dir.path().join("bar.off"), &bar).unwrap();
+    let (lo, hi) = bar.bbox();
+    let height = |p: [f64; 3]| (p[2] - lo[2]) / (hi[2] - lo[2]);
+    let ids: Vec<i64> = bar
+        .positions()
+        .iter()
+        .map(|&p| {
+            if height(p) <= 0.05 {
+                0
+            } else if height(p) >= 0.95 {
+                1
+            } else {
+                -1
+            }
+        })
+        .collect();
+    let dmat = |values: &[i64]| {
+        format!("1 {}\n{}\n", values.len(), values.iter().map(i64::to_string).collect::<Vec<_>>().join("\n"))
+    };
+    std::fs::write(dir.path().join("regions.dmat"), dmat(&ids)).unwrap();
+    let top: Vec<i64> = (0..ids.len() as i64).filter(|&v| ids[v as usize] == 1).collect();
+    std::fs::write(dir.path().join("top.dmat"), dmat(&top)).unwrap();
+    let scenario = |name: &str, top_select: &str| {
+        let text = format!(
+            "name = \"{name}\"\nmesh = \"bar.off\"\nmethods = [\"arap\"]\n\
+             [[regions]]\nname = \"base\"\nrole = \"fixed\"\nselect = {{ dmat = {{ file = \"regions.dmat\", id = 0 }} }}\n\
+             [[regions]]\nname = \"top\"\nrole = \"handle\"\nselect = {top_select}\ntranslate = [0.1, 0.0, 0.0]\n"
+        );
+        let path = dir.path().join(format!("{name}.toml"));
+        std::fs::write(&path, text).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let by_id = scenario("by-id", "{ dmat = { file = \"regions.dmat\", id = 1 } }");
+    let by_index = scenario("by-index", "{ dmat = { file = \"top.dmat\", form = \"indices\" } }");
+    let reports = dir.path().join("reports");
+    let (code, out, err) = harness(&[
+        "run",
+        "--quiet",
+        "--scenario",
+        &by_id,
+        "--scenario",
+        &by_index,
+        "--reports",
+        reports.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{out}{err}");
+    let rows = rows(&reports);
+    assert_eq!(rows.len(), 2);
+    assert_eq!(rows[0]["status"], "ok");
+    for column in ["e_theta_deg", "e_phi_deg", "largest_handle_move_over_diag", "iterations"] {
+        assert_eq!(rows[0][column], rows[1][column], "{column}: the two forms select the same vertices");
+    }
+
+    // The index list given with `id`: it has fewer values than the mesh has vertices.
+    let wrong = scenario("wrong", "{ dmat = { file = \"top.dmat\", id = 1 } }");
+    let (code, out, err) =
+        harness(&["run", "--quiet", "--scenario", &wrong, "--reports", reports.to_str().unwrap()]);
+    assert_eq!(code, 2, "{out}{err}");
+    for needle in [
+        "wrong.toml",
+        "region `top`",
+        "top.dmat",
+        &format!("{} values", top.len()),
+        "looks like an index list",
+        "form = \"indices\"",
+    ] {
+        assert!(err.contains(needle), "{needle:?} not in {err}");
+    }
+}

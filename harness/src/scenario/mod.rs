@@ -540,7 +540,7 @@ impl SelectionFiles for InputFiles {
     }
 
     fn dmat(&self, file: &Path) -> Result<Vec<i64>, String> {
-        meshes::io::read_dmat_column(file, self.n_input).map_err(|e| e.to_string())
+        meshes::io::read_dmat_integers(file).map_err(|e| e.to_string())
     }
 
     fn index_list(&self, file: &Path) -> Result<Vec<u32>, String> {
