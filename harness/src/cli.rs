@@ -526,6 +526,9 @@ fn run_shard(options: &SuiteOptions, staging: StagedDir, shard: Shard) -> anyhow
         run.results.len(),
         target.display()
     );
+    for line in run.input_summary() {
+        println!("{line}");
+    }
     if failed > 0 {
         eprintln!("error: {failed} case(s) failed: {} (see the status column)", failed_cases(&run.results));
         return Ok(ExitCode::from(EXIT_CASE_FAILED));
@@ -575,6 +578,9 @@ fn publish_and_print(
             "{} case(s) unfinished: stopped at their iteration cap, judged on an iterate (see the status column)",
             outcome.unfinished
         );
+    }
+    for line in run.input_summary() {
+        println!("{line}");
     }
     if outcome.failed > 0 {
         eprintln!(

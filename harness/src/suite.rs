@@ -66,6 +66,41 @@ pub struct SuiteRun {
 }
 
 impl SuiteRun {
+    /// The closing summary's lines on the inputs: every mesh of a collection that was skipped (its
+    /// file and reason) and every mesh `repair = true` changed (its file and what changed); empty
+    /// when there are none.
+    pub fn input_summary(&self) -> Vec<String> {
+        let mut lines = Vec::new();
+        if !self.skipped.is_empty() {
+            lines.push(format!(
+                "{} mesh(es) of collections skipped, no case ran on them (index.html, \"Meshes skipped or repaired\"):",
+                self.skipped.len()
+            ));
+            lines.extend(
+                self.skipped
+                    .iter()
+                    .map(|s| format!("  skipped {}: {}: {}", s.scenario, s.file.display(), s.reason)),
+            );
+        }
+        let repaired: Vec<(&str, &crate::scenario::Repaired)> = self
+            .scenarios
+            .iter()
+            .filter_map(|s| Some((s.spec.name.as_str(), s.repaired.as_ref()?)))
+            .collect();
+        if !repaired.is_empty() {
+            lines.push(format!(
+                "{} mesh(es) repaired by `repair = true` before any case ran:",
+                repaired.len()
+            ));
+            lines.extend(
+                repaired
+                    .iter()
+                    .map(|(name, r)| format!("  repaired {name}: {}: {}", r.file.display(), r.changes)),
+            );
+        }
+        lines
+    }
+
     /// With a note per method of `catalog` that could not run here and why (once per run).
     fn with_unavailable(mut self, catalog: &MethodCatalog) -> SuiteRun {
         self.notes.extend(catalog.methods().iter().filter_map(|m| {

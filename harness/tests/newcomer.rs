@@ -220,3 +220,57 @@ fn a_dmat_selection_reads_region_ids_or_an_index_list_and_says_which_it_looks_li
         assert!(err.contains(needle), "{needle:?} not in {err}");
     }
 }
+
+/// A collection of two bars, one with two zero-area faces: without `repair` that mesh is skipped,
+/// with it repaired; either way the closing summary (after the `reports:` line) and the page say
+/// which mesh, with its file and the reason or what changed.
+#[test]
+fn skipped_and_repaired_meshes_are_in_the_closing_summary_and_on_the_page() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("m")).unwrap();
+    let bar = meshes::shapes::generate(meshes::shapes::ShapeKind::Bar, 500).unwrap().mesh;
+    meshes::io::write_off(dir.path().join("m/good.off"), &bar).unwrap();
+    let mut flat = bar.positions().to_vec();
+    let t0 = bar.triangles()[0];
+    flat[t0[2] as usize] = flat[t0[0] as usize];
+    let mut off = format!("OFF\n{} {} 0\n", flat.len(), bar.n_faces());
+    flat.iter().for_each(|p| off += &format!("{} {} {}\n", p[0], p[1], p[2]));
+    bar.triangles().iter().for_each(|t| off += &format!("3 {} {} {}\n", t[0], t[1], t[2]));
+    std::fs::write(dir.path().join("m/flat.off"), off).unwrap();
+    let scenario = |repair: bool| {
+        let text = format!("name = \"set\"\nmeshes = \"m/*.off\"\nrepair = {repair}\nmethods = [\"laplacian\"]\n{FIXED_AND_HANDLE}");
+        let path = dir.path().join("set.toml");
+        std::fs::write(&path, text).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let reports = dir.path().join("reports");
+    let flat_file = dir.path().join("m/flat.off").display().to_string();
+    let closing = |out: &str| out[out.find("\nreports: ").unwrap_or_else(|| panic!("{out}"))..].to_string();
+
+    let (code, out, err) =
+        harness(&["run", "--quiet", "--scenario", &scenario(false), "--reports", reports.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    let summary = closing(&out);
+    let line =
+        summary.lines().find(|l| l.contains("skipped set-flat")).unwrap_or_else(|| panic!("{summary}"));
+    assert!(line.contains(&flat_file) && line.contains("zero area"), "{line}");
+    let page = std::fs::read_to_string(reports.join("index.html")).unwrap();
+    let section = &page[page.find("id=\"inputs\"").expect("the page's section on skipped meshes")..];
+    let section = &section[..section.find("<h2").unwrap_or(section.len())];
+    assert!(
+        section.contains("set-flat") && section.contains(&flat_file) && section.contains("zero area"),
+        "{section}"
+    );
+
+    let (code, out, err) =
+        harness(&["run", "--quiet", "--scenario", &scenario(true), "--reports", reports.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    let summary = closing(&out);
+    let line =
+        summary.lines().find(|l| l.contains("repaired set-flat")).unwrap_or_else(|| panic!("{summary}"));
+    assert!(line.contains(&flat_file) && line.contains("2 zero-area faces dropped"), "{line}");
+    assert!(!summary.contains("set-good"), "the good mesh was neither skipped nor repaired: {summary}");
+    let page = std::fs::read_to_string(reports.join("index.html")).unwrap();
+    let section = &page[page.find("id=\"inputs\"").expect("the page's section on repaired meshes")..];
+    assert!(section.contains("set-flat") && section.contains("2 zero-area faces dropped"), "{section}");
+}

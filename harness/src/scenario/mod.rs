@@ -304,6 +304,15 @@ pub struct LoadedScenario {
     pub notes: Vec<String>,
     /// The collection and mesh this scenario is one of (`meshes` or `[manifest]`).
     pub member: Option<Member>,
+    /// What `repair = true` changed in its mesh file, when it changed something.
+    pub repaired: Option<Repaired>,
+}
+
+/// A mesh file that `repair = true` changed, and what it changed ([`meshes::repair::RepairLog::summary`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Repaired {
+    pub file: PathBuf,
+    pub changes: String,
 }
 
 /// What [`ScenarioSpec::load`] made of a scenario file: the scenarios that load, and the meshes
@@ -688,6 +697,7 @@ impl ScenarioSpec {
             input: None,
             notes: Vec::new(),
             member: None,
+            repaired: None,
         })
     }
 
@@ -707,6 +717,7 @@ impl ScenarioSpec {
         let mut input = meshes::io::read_mesh(path)?;
         let mut notes = Vec::new();
         let mut member = member;
+        let mut repaired_by = None;
         if self.repair {
             // Results are then written with the repaired faces, in the file's vertex order.
             let (repaired, log) = meshes::repair::repair(&input).map_err(|e| e.in_file(path))?;
@@ -715,6 +726,7 @@ impl ScenarioSpec {
                 if let Some(m) = &mut member {
                     m.repaired = Some(log.summary());
                 }
+                repaired_by = Some(Repaired { file: path.to_path_buf(), changes: log.summary() });
             }
             input = repaired;
         }
@@ -768,6 +780,7 @@ impl ScenarioSpec {
             input,
             notes,
             member,
+            repaired: repaired_by,
         })
     }
 
