@@ -613,9 +613,23 @@ fn print_phases(outcome: &Outcome) {
     println!("  {:<38} {total:>8.2}", "sum (loading the inputs is not timed)");
 }
 
-/// The results table on stdout: one row per case, the timings, every metric of the table, the status.
+/// The results table on stdout ([`results_table`]).
 fn print_table(results: &[CaseResult]) {
+    print!("{}", results_table(results));
+}
+
+/// The results table: one row per case, the timings, every metric of the table, the status. A time
+/// that is not a number (an external method without a trace has no iteration time; a failed case
+/// none at all) is `–`, as a missing measure is.
+fn results_table(results: &[CaseResult]) -> String {
     let width = |label: &str| label.chars().count().max(9);
+    let time = |v: f64, width: usize, decimals: usize| {
+        if v.is_finite() {
+            format!("{v:>width$.decimals$}")
+        } else {
+            format!("{:>width$}", "–")
+        }
+    };
     let mut header = format!(
         "{:<14} {:<16} {:>7} {:>9} {:>8} {:>9} {:>6}",
         "scenario", "method", "#V", "precomp s", "bind s", "iter ms", "iters"
@@ -623,11 +637,17 @@ fn print_table(results: &[CaseResult]) {
     for spec in &METRICS {
         header.push_str(&format!(" {:>w$}", spec.label, w = width(spec.label)));
     }
-    println!("{header}  status");
+    let mut table = format!("{header}  status\n");
     for r in results {
         let mut line = format!(
-            "{:<14} {:<16} {:>7} {:>9.4} {:>8.4} {:>9.3} {:>6}",
-            r.scenario, r.method, r.vertices, r.precompute_s, r.bind_s, r.median_iteration_ms, r.iterations
+            "{:<14} {:<16} {:>7} {} {} {} {:>6}",
+            r.scenario,
+            r.method,
+            r.vertices,
+            time(r.precompute_s, 9, 4),
+            time(r.bind_s, 8, 4),
+            time(r.median_iteration_ms, 9, 3),
+            r.iterations
         );
         for spec in &METRICS {
             line.push_str(&format!(
@@ -636,6 +656,31 @@ fn print_table(results: &[CaseResult]) {
                 w = width(spec.label)
             ));
         }
-        println!("{line}  {}", r.status);
+        table.push_str(&format!("{line}  {}\n", r.status));
+    }
+    table
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_results_table_prints_a_dash_where_a_time_is_not_a_number() {
+        // An external method without a trace: no iteration time; a failed case: no times at all.
+        let mut external = CaseResult::empty("bar", "harmonic", "procedural look-alike", 500, 996);
+        (external.precompute_s, external.bind_s, external.iterations) = (0.25, 0.01, 1);
+        let mut failed = CaseResult::empty("bar", "broken", "procedural look-alike", 500, 996);
+        failed.status = crate::verdict::Status::Failed("crashed".into());
+        let table = results_table(&[external, failed]);
+        assert!(!table.to_lowercase().contains("nan") && !table.contains("inf"), "{table}");
+        let rows: Vec<&str> = table.lines().collect();
+        let header = rows[0];
+        let column = header.find("iter ms").unwrap() + "iter ms".len();
+        for row in &rows[1..] {
+            let cell: String = row.chars().take(column).collect::<String>();
+            assert!(cell.ends_with('–'), "the iter ms cell of {row:?} is a dash");
+        }
+        assert!(rows[1].contains("0.2500") && rows[1].contains("0.0100"), "{}", rows[1]);
     }
 }
