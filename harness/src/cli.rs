@@ -459,26 +459,45 @@ where
             let options = common.options(Vec::new(), Vec::new(), &command_line);
             println!("methods ({}):", options.configs_dir.join("methods.toml").display());
             let catalog = suite::load_catalog(&options)?;
-            for m in catalog.methods() {
-                let origin = if m.origin == crate::config::Origin::BuiltIn {
-                    String::new()
-                } else {
-                    format!("[{}] ", m.origin.label())
-                };
-                match &m.unavailable {
-                    None => println!("  {:<14} {origin}{}", m.name, m.summary),
-                    Some(why) => {
-                        println!("  {:<14} {origin}UNAVAILABLE: {why} ({})", m.name, m.file.display())
-                    }
-                }
-            }
+            let methods: Vec<Vec<String>> = catalog
+                .methods()
+                .iter()
+                .map(|m| {
+                    let what = match &m.unavailable {
+                        None => m.summary.clone(),
+                        Some(why) => format!("UNAVAILABLE: {why} ({})", m.file.display()),
+                    };
+                    vec![m.name.clone(), m.origin.label().to_string(), what]
+                })
+                .collect();
+            columns(&methods).iter().for_each(|line| println!("{line}"));
             println!("scenarios ({}):", options.configs_dir.join("scenarios").display());
-            for s in load_specs(&options.configs_dir.join("scenarios"))? {
-                println!("  {:<14} {}", s.name, s.description);
-            }
+            let scenarios: Vec<Vec<String>> = load_specs(&options.configs_dir.join("scenarios"))?
+                .into_iter()
+                .map(|s| vec![s.name, s.description])
+                .collect();
+            columns(&scenarios).iter().for_each(|line| println!("{line}"));
             Ok(ExitCode::SUCCESS)
         }
     }
+}
+
+/// `rows` as lines of aligned columns: indented by two, each column but the last as wide as its
+/// widest cell, two spaces between columns.
+fn columns(rows: &[Vec<String>]) -> Vec<String> {
+    let count = rows.iter().map(Vec::len).max().unwrap_or(0);
+    let widths: Vec<usize> = (0..count)
+        .map(|c| rows.iter().filter_map(|r| r.get(c)).map(|cell| cell.chars().count()).max().unwrap_or(0))
+        .collect();
+    rows.iter()
+        .map(|row| {
+            let mut line = String::from(" ");
+            for (cell, width) in row.iter().zip(&widths) {
+                line.push_str(&format!(" {cell:<width$} "));
+            }
+            line.trim_end().to_string()
+        })
+        .collect()
 }
 
 /// Print the gate's findings; the exit code is [`EXIT_REGRESSION`] if any is a regression.

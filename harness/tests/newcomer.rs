@@ -274,3 +274,49 @@ fn skipped_and_repaired_meshes_are_in_the_closing_summary_and_on_the_page() {
     let section = &page[page.find("id=\"inputs\"").expect("the page's section on repaired meshes")..];
     assert!(section.contains("set-flat") && section.contains("2 zero-area faces dropped"), "{section}");
 }
+
+/// Where the columns of `row` start (in characters): its cells are separated by at least two
+/// spaces and hold no two spaces in a row themselves, but the last (free text) may.
+fn column_starts(row: &str, columns: usize) -> Vec<usize> {
+    let chars: Vec<char> = row.chars().collect();
+    let mut starts = vec![chars.iter().position(|c| *c != ' ').unwrap()];
+    while starts.len() < columns {
+        let mut i = *starts.last().unwrap();
+        while i + 1 < chars.len() && !(chars[i] == ' ' && chars[i + 1] == ' ') {
+            i += 1;
+        }
+        while i < chars.len() && chars[i] == ' ' {
+            i += 1;
+        }
+        starts.push(i);
+    }
+    starts
+}
+
+#[test]
+fn list_aligns_its_columns() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("mine.toml");
+    std::fs::write(
+        &file,
+        "[a_rather_long_external_method_name]\ncommand = [\"python3\", \"mine.py\"]\nsummary = \"mine\"\n",
+    )
+    .unwrap();
+    let (code, out, err) = harness(&["list", "--methods", file.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    let lines: Vec<&str> = out.lines().collect();
+    let methods_at = lines.iter().position(|l| l.starts_with("methods (")).unwrap();
+    let scenarios_at = lines.iter().position(|l| l.starts_with("scenarios (")).unwrap();
+    let methods = &lines[methods_at + 1..scenarios_at];
+    let scenarios = &lines[scenarios_at + 1..];
+    assert!(methods.iter().any(|l| l.contains("a_rather_long_external_method_name")), "{out}");
+    assert!(methods.iter().any(|l| l.contains("isolines[isolines=10]")), "{out}");
+    let first = column_starts(methods[0], 3);
+    for row in methods {
+        assert_eq!(column_starts(row, 3), first, "method columns of {row:?} in\n{out}");
+    }
+    let first = column_starts(scenarios[0], 2);
+    for row in scenarios {
+        assert_eq!(column_starts(row, 2), first, "scenario columns of {row:?} in\n{out}");
+    }
+}
