@@ -320,3 +320,62 @@ fn list_aligns_its_columns() {
         assert_eq!(column_starts(row, 2), first, "scenario columns of {row:?} in\n{out}");
     }
 }
+
+/// A directory made unwritable for this process until dropped: the immutable flag for root (whom
+/// permission bits do not stop), read-only permissions otherwise. `None` when neither works here.
+struct Unwritable(std::path::PathBuf);
+
+impl Unwritable {
+    fn new(dir: &Path) -> Option<Unwritable> {
+        let root = Command::new("id").arg("-u").output().is_ok_and(|o| o.stdout.starts_with(b"0\n"));
+        let made = if root {
+            Command::new("chattr").arg("+i").arg(dir).status().is_ok_and(|s| s.success())
+        } else {
+            use std::os::unix::fs::PermissionsExt;
+            std::fs::set_permissions(dir, std::fs::Permissions::from_mode(0o555)).is_ok()
+        };
+        let guard = made.then(|| Unwritable(dir.to_path_buf()));
+        // Whatever was done, it must hold: a probe file cannot be made.
+        let probe = dir.join(".probe");
+        if std::fs::write(&probe, "").is_ok() {
+            let _ = std::fs::remove_file(probe);
+            return None;
+        }
+        guard
+    }
+}
+
+impl Drop for Unwritable {
+    fn drop(&mut self) {
+        use std::os::unix::fs::PermissionsExt;
+        let _ = Command::new("chattr").arg("-i").arg(&self.0).status();
+        let _ = std::fs::set_permissions(&self.0, std::fs::Permissions::from_mode(0o755));
+    }
+}
+
+#[test]
+fn a_report_directory_that_cannot_be_written_stops_the_run_before_it_starts() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = bar_scenario(dir.path(), "first", "methods = [\"arap\", \"laplacian\"]\n");
+    let reports = dir.path().join("reports");
+    std::fs::create_dir(&reports).unwrap();
+    std::fs::write(reports.join("index.html"), "old page").unwrap();
+    let Some(_locked) = Unwritable::new(&reports) else {
+        eprintln!("SKIPPED: cannot make a directory unwritable here");
+        return;
+    };
+    let (code, out, err) =
+        harness(&["run", "--quiet", "--scenario", &scenario, "--reports", reports.to_str().unwrap()]);
+    assert_eq!(code, 2, "{out}{err}");
+    assert!(err.contains(&reports.display().to_string()) && err.contains("cannot be written"), "{err}");
+    assert!(!out.contains("time by phase") && !out.contains("laplacian"), "no case ran: {out}");
+    assert_eq!(std::fs::read_to_string(reports.join("index.html")).unwrap(), "old page");
+
+    // A report directory not made yet, under one that cannot be written: named too.
+    let below = reports.join("new/reports");
+    let (code, out, err) =
+        harness(&["run", "--quiet", "--scenario", &scenario, "--reports", below.to_str().unwrap()]);
+    assert_eq!(code, 2, "{out}{err}");
+    assert!(err.contains(&reports.display().to_string()) && err.contains("cannot be written"), "{err}");
+    assert!(err.contains(&below.display().to_string()), "{err}");
+}
