@@ -379,3 +379,32 @@ fn a_report_directory_that_cannot_be_written_stops_the_run_before_it_starts() {
     assert!(err.contains(&reports.display().to_string()) && err.contains("cannot be written"), "{err}");
     assert!(err.contains(&below.display().to_string()), "{err}");
 }
+
+/// The README's own-mesh example is a scenario file the harness accepts (no unknown key), and it
+/// shows what a newcomer needs: `up`, `repair`, and both kinds of `.dmat` selection.
+#[test]
+fn the_readme_scenario_example_parses_and_shows_up_repair_and_both_dmat_forms() {
+    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md")).unwrap();
+    let start = readme.find("<!-- own-mesh-scenario -->").expect("the example's marker");
+    let end = readme.find("<!-- /own-mesh-scenario -->").expect("the example's end marker");
+    let block = &readme[start..end];
+    let toml = &block[block.find("```toml\n").unwrap() + 8..block.rfind("```").unwrap()];
+    for needle in ["up = \"y\"", "repair = true", "id = ", "form = \"indices\""] {
+        assert!(toml.contains(needle), "{needle:?} not in the example:\n{toml}");
+    }
+    // The commented alternative is a selection too: uncommented in place of the first, it parses.
+    let alternative = toml.lines().find(|l| l.starts_with("# select = { dmat")).unwrap();
+    let with_indices = toml
+        .lines()
+        .filter(|l| !l.contains("id = 2"))
+        .map(|l| if l == alternative { &l[2..] } else { l })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in [("dragon.toml", toml.to_string()), ("dragon-indices.toml", with_indices)] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let spec = harness::scenario::load_spec(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(spec.repair && spec.up.is_some() && spec.regions.len() == 3, "{name}");
+    }
+}
