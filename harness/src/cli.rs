@@ -70,14 +70,16 @@ enum Command {
         #[arg(long)]
         sweeps: bool,
     },
-    /// Run chosen methods on one scenario and print the results (writes reports/ like `all`).
+    /// Run chosen methods on chosen scenarios and print the results (writes reports/ like `all`).
     Run {
-        /// Method name (repeatable; see `list`).
-        #[arg(long = "method", required = true)]
+        /// Method name (repeatable; see `list`). Without it each scenario runs the methods its
+        /// `methods = [...]` lists; a scenario that lists none is then an error naming it (give
+        /// --method, or run every method with `all --scenarios DIR`).
+        #[arg(long = "method")]
         methods: Vec<String>,
-        /// Scenario name (see `list`), or the path of a scenario file.
-        #[arg(long)]
-        scenario: String,
+        /// Scenario name (see `list`), or the path of a scenario file (repeatable).
+        #[arg(long = "scenario", required = true)]
+        scenarios: Vec<String>,
         #[command(flatten)]
         common: Common,
         #[command(flatten)]
@@ -402,8 +404,11 @@ where
             let publish = PublishOptions { peer_python: None, meshes: meshes.output() };
             publish_and_print(&staged_options, staging, run, &publish, gate)
         }
-        Command::Run { methods, scenario, common, peers, meshes } => {
-            let mut options = common.options(vec![scenario], methods, &command_line)?;
+        Command::Run { methods, scenarios, common, peers, meshes } => {
+            let mut options = common.options(scenarios, methods, &command_line)?;
+            if options.methods.is_empty() {
+                suite::require_listed_methods(&options)?;
+            }
             options.python = peers.python_path();
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
@@ -416,7 +421,7 @@ where
                 staging,
                 run,
                 &publish,
-                GateRequest::Skip("`run` covers one scenario".to_string()),
+                GateRequest::Skip("`run` covers chosen scenarios and methods".to_string()),
             )
         }
         Command::Check { common, gate } => {
@@ -497,26 +502,45 @@ where
             let options = common.options(Vec::new(), Vec::new(), &command_line)?;
             println!("methods ({}):", options.configs_dir.join("methods.toml").display());
             let catalog = suite::load_catalog(&options)?;
-            for m in catalog.methods() {
-                let origin = if m.origin == crate::config::Origin::BuiltIn {
-                    String::new()
-                } else {
-                    format!("[{}] ", m.origin.label())
-                };
-                match &m.unavailable {
-                    None => println!("  {:<14} {origin}{}", m.name, m.summary),
-                    Some(why) => {
-                        println!("  {:<14} {origin}UNAVAILABLE: {why} ({})", m.name, m.file.display())
-                    }
-                }
-            }
+            let methods: Vec<Vec<String>> = catalog
+                .methods()
+                .iter()
+                .map(|m| {
+                    let what = match &m.unavailable {
+                        None => m.summary.clone(),
+                        Some(why) => format!("UNAVAILABLE: {why} ({})", m.file.display()),
+                    };
+                    vec![m.name.clone(), m.origin.label().to_string(), what]
+                })
+                .collect();
+            columns(&methods).iter().for_each(|line| println!("{line}"));
             println!("scenarios ({}):", options.configs_dir.join("scenarios").display());
-            for s in load_specs(&options.configs_dir.join("scenarios"))? {
-                println!("  {:<14} {}", s.name, s.description);
-            }
+            let scenarios: Vec<Vec<String>> = load_specs(&options.configs_dir.join("scenarios"))?
+                .into_iter()
+                .map(|s| vec![s.name, s.description])
+                .collect();
+            columns(&scenarios).iter().for_each(|line| println!("{line}"));
             Ok(ExitCode::SUCCESS)
         }
     }
+}
+
+/// `rows` as lines of aligned columns: indented by two, each column but the last as wide as its
+/// widest cell, two spaces between columns.
+fn columns(rows: &[Vec<String>]) -> Vec<String> {
+    let count = rows.iter().map(Vec::len).max().unwrap_or(0);
+    let widths: Vec<usize> = (0..count)
+        .map(|c| rows.iter().filter_map(|r| r.get(c)).map(|cell| cell.chars().count()).max().unwrap_or(0))
+        .collect();
+    rows.iter()
+        .map(|row| {
+            let mut line = String::from(" ");
+            for (cell, width) in row.iter().zip(&widths) {
+                line.push_str(&format!(" {cell:<width$} "));
+            }
+            line.trim_end().to_string()
+        })
+        .collect()
 }
 
 /// Print the gate's findings; the exit code is [`EXIT_REGRESSION`] if any is a regression.
@@ -564,6 +588,9 @@ fn run_shard(options: &SuiteOptions, staging: StagedDir, shard: Shard) -> anyhow
         run.results.len(),
         target.display()
     );
+    for line in run.input_summary() {
+        println!("{line}");
+    }
     if failed > 0 {
         eprintln!("error: {failed} case(s) failed: {} (see the status column)", failed_cases(&run.results));
         return Ok(ExitCode::from(EXIT_CASE_FAILED));
@@ -614,6 +641,9 @@ fn publish_and_print(
             outcome.unfinished
         );
     }
+    for line in run.input_summary() {
+        println!("{line}");
+    }
     if outcome.failed > 0 {
         eprintln!(
             "error: {} case(s) failed: {} (see the status column)",
@@ -645,9 +675,23 @@ fn print_phases(outcome: &Outcome) {
     println!("  {:<38} {total:>8.2}", "sum (loading the inputs is not timed)");
 }
 
-/// The results table on stdout: one row per case, the timings, every metric of the table, the status.
+/// The results table on stdout ([`results_table`]).
 fn print_table(results: &[CaseResult]) {
+    print!("{}", results_table(results));
+}
+
+/// The results table: one row per case, the timings, every metric of the table, the status. A time
+/// that is not a number (an external method without a trace has no iteration time; a failed case
+/// none at all) is `–`, as a missing measure is.
+fn results_table(results: &[CaseResult]) -> String {
     let width = |label: &str| label.chars().count().max(9);
+    let time = |v: f64, width: usize, decimals: usize| {
+        if v.is_finite() {
+            format!("{v:>width$.decimals$}")
+        } else {
+            format!("{:>width$}", "–")
+        }
+    };
     let mut header = format!(
         "{:<14} {:<16} {:>7} {:>9} {:>8} {:>9} {:>6}",
         "scenario", "method", "#V", "precomp s", "bind s", "iter ms", "iters"
@@ -655,11 +699,17 @@ fn print_table(results: &[CaseResult]) {
     for spec in &METRICS {
         header.push_str(&format!(" {:>w$}", spec.label, w = width(spec.label)));
     }
-    println!("{header}  status");
+    let mut table = format!("{header}  status\n");
     for r in results {
         let mut line = format!(
-            "{:<14} {:<16} {:>7} {:>9.4} {:>8.4} {:>9.3} {:>6}",
-            r.scenario, r.method, r.vertices, r.precompute_s, r.bind_s, r.median_iteration_ms, r.iterations
+            "{:<14} {:<16} {:>7} {} {} {} {:>6}",
+            r.scenario,
+            r.method,
+            r.vertices,
+            time(r.precompute_s, 9, 4),
+            time(r.bind_s, 8, 4),
+            time(r.median_iteration_ms, 9, 3),
+            r.iterations
         );
         for spec in &METRICS {
             line.push_str(&format!(
@@ -668,6 +718,31 @@ fn print_table(results: &[CaseResult]) {
                 w = width(spec.label)
             ));
         }
-        println!("{line}  {}", r.status);
+        table.push_str(&format!("{line}  {}\n", r.status));
+    }
+    table
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_results_table_prints_a_dash_where_a_time_is_not_a_number() {
+        // An external method without a trace: no iteration time; a failed case: no times at all.
+        let mut external = CaseResult::empty("bar", "harmonic", "procedural look-alike", 500, 996);
+        (external.precompute_s, external.bind_s, external.iterations) = (0.25, 0.01, 1);
+        let mut failed = CaseResult::empty("bar", "broken", "procedural look-alike", 500, 996);
+        failed.status = crate::verdict::Status::Failed("crashed".into());
+        let table = results_table(&[external, failed]);
+        assert!(!table.to_lowercase().contains("nan") && !table.contains("inf"), "{table}");
+        let rows: Vec<&str> = table.lines().collect();
+        let header = rows[0];
+        let column = header.find("iter ms").unwrap() + "iter ms".len();
+        for row in &rows[1..] {
+            let cell: String = row.chars().take(column).collect::<String>();
+            assert!(cell.ends_with('–'), "the iter ms cell of {row:?} is a dash");
+        }
+        assert!(rows[1].contains("0.2500") && rows[1].contains("0.0100"), "{}", rows[1]);
     }
 }

@@ -388,7 +388,11 @@ impl MethodCatalog {
     /// The method called `name`, or an error listing the known names.
     pub fn find(&self, name: &str) -> Result<&ConfiguredMethod, String> {
         self.get(name).ok_or_else(|| {
-            format!("unknown method `{name}`; known methods: {}", self.names().collect::<Vec<_>>().join(", "))
+            format!(
+                "unknown method `{name}`{}; known methods: {}",
+                crate::error::did_you_mean(name, self.names()),
+                self.names().collect::<Vec<_>>().join(", ")
+            )
         })
     }
 

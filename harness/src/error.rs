@@ -8,8 +8,9 @@ use std::path::PathBuf;
 pub enum HarnessError {
     #[error("{}: {message}", path.display())]
     Config { path: PathBuf, message: String },
-    #[error("scenario `{scenario}`: {message}")]
-    Scenario { scenario: String, message: String },
+    /// A scenario's input is wrong; `file` is the scenario file, when there is one.
+    #[error("scenario `{scenario}`{}: {message}", file.as_ref().map(|f| format!(" ({})", f.display())).unwrap_or_default())]
+    Scenario { scenario: String, file: Option<PathBuf>, message: String },
     #[error(transparent)]
     Mesh(#[from] meshes::MeshError),
     #[error(transparent)]
@@ -18,4 +19,38 @@ pub enum HarnessError {
     Io { path: PathBuf, error: std::io::Error },
     #[error("{0}")]
     Report(String),
+}
+
+/// ` (did you mean `x`?)` when one of `known` is a likely misspelling of `name` (the nearest by
+/// Damerau–Levenshtein distance, ignoring case, at most a third of the name's length away and at
+/// least 2; else one that `name` begins), or nothing.
+pub fn did_you_mean<'a>(name: &str, known: impl IntoIterator<Item = &'a str>) -> String {
+    let lower = name.to_lowercase();
+    let known: Vec<&str> = known.into_iter().filter(|k| *k != name).collect();
+    let nearest = known
+        .iter()
+        .map(|k| (strsim::damerau_levenshtein(&lower, &k.to_lowercase()), *k))
+        .min_by_key(|(distance, _)| *distance)
+        .filter(|(distance, _)| *distance <= (name.chars().count() / 3).max(2))
+        .map(|(_, k)| k);
+    let begun =
+        || known.iter().copied().find(|k| lower.chars().count() >= 3 && k.to_lowercase().starts_with(&lower));
+    nearest.or_else(begun).map(|k| format!(" (did you mean `{k}`?)")).unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::did_you_mean;
+
+    #[test]
+    fn a_near_name_is_suggested_and_a_far_one_is_not() {
+        let methods = ["laplacian", "arap", "isolines", "hirm", "scale_aware", "scale_aware_ora"];
+        assert_eq!(did_you_mean("isoline", methods), " (did you mean `isolines`?)");
+        assert_eq!(did_you_mean("hirn", methods), " (did you mean `hirm`?)");
+        assert_eq!(did_you_mean("lapalcian", methods), " (did you mean `laplacian`?)");
+        assert_eq!(did_you_mean("ARAP", methods), " (did you mean `arap`?)");
+        assert_eq!(did_you_mean("scale", methods), " (did you mean `scale_aware`?)");
+        assert_eq!(did_you_mean("cylinder", methods), "");
+        assert_eq!(did_you_mean("x", methods), "");
+    }
 }

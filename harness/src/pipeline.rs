@@ -220,6 +220,8 @@ pub fn publish(
             peers: &peers,
             gate: &outcome,
             notes: &run.notes,
+            scenarios: &run.scenarios,
+            skipped: &run.skipped,
             viewable: &viewable,
             dataset: &dataset,
             size_series: &size_series,

@@ -64,6 +64,25 @@ impl StagedDir {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
+        // Checked before the run, not found when publishing after every case ran: the report
+        // directory (its old entries are swapped out and removed) and the directory the staging
+        // one is made in, or the nearest one that exists.
+        let existing = |p: &Path| p.ancestors().find(|a| a.exists()).map(Path::to_path_buf);
+        let checked = [swapped.is_dir().then(|| swapped.clone()), existing(&parent)];
+        if let Some(locked) = checked.into_iter().flatten().find(|d| !writable(d)) {
+            let what = if locked == swapped {
+                "the report directory cannot be written".to_string()
+            } else {
+                format!("cannot be written, and the report directory {} is made in it", target.display())
+            };
+            return Err(HarnessError::Config {
+                path: locked,
+                message: format!(
+                    "{what}: the run could not publish its report, so nothing was run (give --reports \
+                     another directory, or make this one writable)"
+                ),
+            });
+        }
         std::fs::create_dir_all(&parent).map_err(io(&parent))?;
         let prefix = staging_prefix(&swapped);
         remove_abandoned(&parent, &prefix);
@@ -115,6 +134,22 @@ impl Drop for StagedDir {
             let _ = std::fs::remove_dir_all(&self.staging);
         }
     }
+}
+
+/// Whether this process may create and remove entries in the directory `dir` (`access(2)`, which
+/// also sees a read-only mount and the immutable flag, even for root).
+#[cfg(target_os = "linux")]
+fn writable(dir: &Path) -> bool {
+    use std::os::unix::ffi::OsStrExt;
+    let Ok(path) = std::ffi::CString::new(dir.as_os_str().as_bytes()) else { return false };
+    // SAFETY: a NUL-terminated path that outlives the call; access reads nothing else.
+    unsafe { libc::access(path.as_ptr(), libc::W_OK | libc::X_OK) == 0 }
+}
+
+/// Whether the directory `dir` is not marked read-only.
+#[cfg(not(target_os = "linux"))]
+fn writable(dir: &Path) -> bool {
+    std::fs::metadata(dir).is_ok_and(|m| !m.permissions().readonly())
 }
 
 /// The error of an I/O operation on `path`.

@@ -66,6 +66,41 @@ pub struct SuiteRun {
 }
 
 impl SuiteRun {
+    /// The closing summary's lines on the inputs: every mesh of a collection that was skipped (its
+    /// file and reason) and every mesh `repair = true` changed (its file and what changed); empty
+    /// when there are none.
+    pub fn input_summary(&self) -> Vec<String> {
+        let mut lines = Vec::new();
+        if !self.skipped.is_empty() {
+            lines.push(format!(
+                "{} mesh(es) of collections skipped, no case ran on them (index.html, \"Meshes skipped or repaired\"):",
+                self.skipped.len()
+            ));
+            lines.extend(
+                self.skipped
+                    .iter()
+                    .map(|s| format!("  skipped {}: {}: {}", s.scenario, s.file.display(), s.reason)),
+            );
+        }
+        let repaired: Vec<(&str, &crate::scenario::Repaired)> = self
+            .scenarios
+            .iter()
+            .filter_map(|s| Some((s.spec.name.as_str(), s.repaired.as_ref()?)))
+            .collect();
+        if !repaired.is_empty() {
+            lines.push(format!(
+                "{} mesh(es) repaired by `repair = true` before any case ran:",
+                repaired.len()
+            ));
+            lines.extend(
+                repaired
+                    .iter()
+                    .map(|(name, r)| format!("  repaired {name}: {}: {}", r.file.display(), r.changes)),
+            );
+        }
+        lines
+    }
+
     /// With a note per method of `catalog` that could not run here and why (once per run).
     fn with_unavailable(mut self, catalog: &MethodCatalog) -> SuiteRun {
         self.notes.extend(catalog.methods().iter().filter_map(|m| {
@@ -146,20 +181,34 @@ pub fn prepare(options: &SuiteOptions) -> Result<Prepared, HarnessError> {
                 message: format!("[{m}]: cannot run here: {}", why.1),
             });
         }
-        catalog.find(m).map_err(|message| {
-            let peers = options.configs_dir.join("peers.toml");
-            let is_peer = std::fs::read_to_string(&peers).is_ok_and(|t| t.contains(&format!("[{m}]")));
-            let hint = if is_peer && options.peers.is_none() { " (a peer: add --peers)" } else { "" };
-            HarnessError::Config { path: catalog.path().to_path_buf(), message: format!("{message}{hint}") }
-        })?;
+        // The name came from the command line: the error says so, not methods.toml.
+        if let Some(message) = unknown_method(options, &catalog, m) {
+            return Err(HarnessError::Report(format!("--method {m}: {message}")));
+        }
     }
     if let Some(sweeps) = &options.sweeps {
         check_sweep_scenarios(options, &catalog, sweeps)?;
     }
     let specs = select_specs(options)?;
     for spec in &specs {
-        for m in spec.methods.iter().flatten().chain(spec.left_out.keys()) {
-            catalog.find(m).map_err(|message| HarnessError::Config { path: spec.path.clone(), message })?;
+        let named = spec
+            .methods
+            .iter()
+            .flatten()
+            .map(|m| ("methods", m))
+            .chain(spec.left_out.keys().map(|m| ("left_out", m)));
+        for (key, m) in named {
+            if let Some(message) = unknown_method(options, &catalog, m) {
+                let key = if key == "left_out" {
+                    format!("left_out.{m}")
+                } else {
+                    format!("methods = [.. \"{m}\" ..]")
+                };
+                return Err(HarnessError::Config {
+                    path: spec.path.clone(),
+                    message: format!("{key}: {message}"),
+                });
+            }
         }
     }
     let source = options.data_source()?;
@@ -171,6 +220,16 @@ pub fn prepare(options: &SuiteOptions) -> Result<Prepared, HarnessError> {
         skipped.extend(loaded.skipped);
     }
     Ok(Prepared { config: RunConfig { catalog, rules }, scenarios, skipped, source })
+}
+
+/// Why `name` is no method of `catalog` (with the nearest name, and whether it is a peer that
+/// needs `--peers`), or `None` when it is one.
+fn unknown_method(options: &SuiteOptions, catalog: &MethodCatalog, name: &str) -> Option<String> {
+    let message = catalog.find(name).err()?;
+    let peers = options.configs_dir.join("peers.toml");
+    let is_peer = std::fs::read_to_string(&peers).is_ok_and(|t| t.contains(&format!("[{name}]")));
+    let hint = if is_peer && options.peers.is_none() { " (a peer: add --peers)" } else { "" };
+    Some(format!("{message}{hint}"))
 }
 
 /// Every scenario a sweep file's `scenarios` names exists, in the run's scenario directory or the
@@ -221,6 +280,27 @@ pub fn load_catalog(options: &SuiteOptions) -> Result<MethodCatalog, HarnessErro
     Ok(catalog)
 }
 
+/// `run` without `--method` runs each scenario's own `methods = [...]`: an error naming every
+/// selected scenario that lists none (rather than running every method on it, which is `all`'s
+/// job), and saying what to give instead.
+pub fn require_listed_methods(options: &SuiteOptions) -> Result<(), HarnessError> {
+    let specs = select_specs(options)?;
+    let without: Vec<String> = specs
+        .iter()
+        .filter(|s| s.methods.is_none())
+        .map(|s| format!("`{}` ({})", s.name, s.path.display()))
+        .collect();
+    if without.is_empty() {
+        return Ok(());
+    }
+    Err(HarnessError::Report(format!(
+        "no --method given, and scenario {} lists no `methods = [...]`: give --method NAME (repeatable; \
+         `harness list` shows the names), add `methods` to the scenario file, or run every method with \
+         `harness all --scenarios DIR`",
+        without.join(", ")
+    )))
+}
+
 /// The scenario files of the run: every one in the scenarios directory, or the ones named (by name, or
 /// by the path of a `.toml` file anywhere).
 fn select_specs(options: &SuiteOptions) -> Result<Vec<ScenarioSpec>, HarnessError> {
@@ -235,7 +315,14 @@ fn select_specs(options: &SuiteOptions) -> Result<Vec<ScenarioSpec>, HarnessErro
                 let known: Vec<&str> = specs.iter().map(|s| s.name.as_str()).collect();
                 return Err(HarnessError::Scenario {
                     scenario: name.to_string(),
-                    message: format!("no such scenario in {}; known: {}", dir.display(), known.join(", ")),
+                    file: None,
+                    message: format!(
+                        "--scenario {name}: no such scenario in {}{}; known: {} (or give the path of a \
+                         scenario file)",
+                        dir.display(),
+                        crate::error::did_you_mean(name, known.iter().copied()),
+                        known.join(", ")
+                    ),
                 });
             }
         }

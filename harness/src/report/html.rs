@@ -44,6 +44,10 @@ pub struct PageContext<'a> {
     pub gate: &'a GateOutcome,
     /// Notes on the inputs.
     pub notes: &'a [String],
+    /// The scenarios the run loaded (what `repair = true` changed in their meshes).
+    pub scenarios: &'a [crate::scenario::LoadedScenario],
+    /// The meshes of collections skipped before any case ran.
+    pub skipped: &'a [crate::scenario::SkippedInput],
     /// The case file stems that open in the 3D view.
     pub viewable: &'a [String],
     /// `dataset.md` (empty: not a dataset run).
@@ -59,6 +63,7 @@ type Section = fn(&mut String, &PageContext);
 const SECTIONS: &[Section] = &[
     head,
     regression_gate,
+    skipped_and_repaired,
     across_the_dataset,
     answer_first,
     cost_against_size,
@@ -400,6 +405,51 @@ fn glossary(page: &mut String, _: &PageContext) {
          peer libraries' methods (<code>--peers</code>, <code>configs/peers.toml</code>), <span class=\"origin\">external</span> \
          other programs over the method protocol (README); hover the mark for what ran.</p>\n",
     );
+}
+
+/// The meshes of collections skipped before any case ran, with their reasons, and the meshes
+/// `repair = true` changed, with what it changed: high on the page, since no row of the results
+/// table shows either.
+fn skipped_and_repaired(page: &mut String, context: &PageContext) {
+    let repaired: Vec<(&str, &crate::scenario::Repaired)> =
+        context.scenarios.iter().filter_map(|s| Some((s.spec.name.as_str(), s.repaired.as_ref()?))).collect();
+    if context.skipped.is_empty() && repaired.is_empty() {
+        return;
+    }
+    page.push_str("<h2 id=\"inputs\">Meshes skipped or repaired</h2>\n");
+    fn table(page: &mut String, last: &str, rows: Vec<(&str, &Path, &str)>) {
+        let _ = writeln!(page, "<table>\n<tr><th>scenario</th><th>file</th><th>{last}</th></tr>");
+        for (scenario, file, what) in rows {
+            let _ = writeln!(
+                page,
+                "<tr><td>{}</td><td>{}</td><td>{}</td></tr>",
+                escape(scenario),
+                escape(&file.display().to_string()),
+                escape(what)
+            );
+        }
+        page.push_str("</table>\n");
+    }
+    if !context.skipped.is_empty() {
+        let _ = writeln!(
+            page,
+            "<p>{} mesh(es) of collections were skipped: no case ran on them, for the reason given \
+             (<code>repair = true</code> fixes broken faces).</p>",
+            context.skipped.len()
+        );
+        let rows = context.skipped.iter().map(|s| (s.scenario.as_str(), s.file.as_path(), s.reason.as_str()));
+        table(page, "reason", rows.collect());
+    }
+    if !repaired.is_empty() {
+        let _ = writeln!(
+            page,
+            "<p>{} mesh(es) were changed by <code>repair = true</code> before any case ran; their results are \
+             of the repaired mesh.</p>",
+            repaired.len()
+        );
+        let rows = repaired.iter().map(|(name, r)| (*name, r.file.as_path(), r.changes.as_str()));
+        table(page, "what changed", rows.collect());
+    }
 }
 
 /// Notes on the inputs (skipped meshes, repairs).

@@ -111,26 +111,28 @@ pub fn render_markdown(rows: &[ArapAgainstLibigl]) -> String {
          |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n"
     );
     let cap = |converged: bool| if converged { "" } else { "*" };
+    // This table is printed at the end of a run too: no `NaN` there.
+    let number = |v: f64, text: String| if v.is_finite() { text } else { "–".to_string() };
     let side = |s: Option<&Side>| match s {
         Some(s) => format!(
-            "{}{} | {:.3} | {:.2} | {:.1e}",
+            "{}{} | {} | {} | {}",
             s.iterations,
             cap(s.converged),
-            s.seconds,
-            s.ratio,
-            s.rms_over_diag
+            number(s.seconds, format!("{:.3}", s.seconds)),
+            number(s.ratio, format!("{:.2}", s.ratio)),
+            number(s.rms_over_diag, format!("{:.1e}", s.rms_over_diag))
         ),
         None => "– | – | – | –".to_string(),
     };
     for r in rows {
         let _ = writeln!(
             out,
-            "| {} | {} | {}{} | {:.3} | {} | {} |",
+            "| {} | {} | {}{} | {} | {} | {} |",
             r.scenario,
             r.vertices,
             r.libigl_iterations,
             cap(r.libigl_converged),
-            r.libigl_s,
+            number(r.libigl_s, format!("{:.3}", r.libigl_s)),
             side(Some(&r.ours)),
             side(r.like_for_like.as_ref()),
         );

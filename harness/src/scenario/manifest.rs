@@ -133,7 +133,7 @@ impl ManifestSpec {
     /// The rows of the manifest that meet every condition (and are in `files`, when given), in the
     /// manifest's order of `file` names sorted; paths relative to the manifest's directory.
     pub fn entries(&self, paths: &PathContext) -> Result<Vec<ManifestEntry>, String> {
-        let manifest = paths.resolve(&self.file)?;
+        let manifest = paths.resolve_existing("manifest.file", &self.file)?;
         let at = |message: String| format!("manifest {}: {message}", manifest.display());
         let conditions: Vec<Condition> =
             self.conditions.iter().map(|c| Condition::parse(c)).collect::<Result<_, _>>()?;

@@ -304,6 +304,15 @@ pub struct LoadedScenario {
     pub notes: Vec<String>,
     /// The collection and mesh this scenario is one of (`meshes` or `[manifest]`).
     pub member: Option<Member>,
+    /// What `repair = true` changed in its mesh file, when it changed something.
+    pub repaired: Option<Repaired>,
+}
+
+/// A mesh file that `repair = true` changed, and what it changed ([`meshes::repair::RepairLog::summary`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Repaired {
+    pub file: PathBuf,
+    pub changes: String,
 }
 
 /// What [`ScenarioSpec::load`] made of a scenario file: the scenarios that load, and the meshes
@@ -540,7 +549,7 @@ impl SelectionFiles for InputFiles {
     }
 
     fn dmat(&self, file: &Path) -> Result<Vec<i64>, String> {
-        meshes::io::read_dmat_column(file, self.n_input).map_err(|e| e.to_string())
+        meshes::io::read_dmat_integers(file).map_err(|e| e.to_string())
     }
 
     fn index_list(&self, file: &Path) -> Result<Vec<u32>, String> {
@@ -561,13 +570,17 @@ impl ScenarioSpec {
     /// no constrained vertex) is skipped with its reason; the others load. Errors: a single mesh
     /// that cannot be loaded, a collection that matches no file or whose every file is skipped.
     pub fn load(&self, source: &DataSource) -> Result<Loaded, HarnessError> {
-        let fail = |message: String| HarnessError::Scenario { scenario: self.name.clone(), message };
+        let fail = |message: String| HarnessError::Scenario {
+            scenario: self.name.clone(),
+            file: Some(self.path.clone()),
+            message,
+        };
         let members: Vec<(PathBuf, Vec<(String, String)>)> = if let Some(manifest) = &self.manifest {
             let entries = manifest.entries(&self.paths(None)).map_err(fail)?;
             entries.into_iter().map(|e| (e.path, e.columns)).collect()
         } else if let Some(pattern) = &self.meshes {
-            let resolved = self.paths(None).resolve(pattern).map_err(fail)?;
-            let text = resolved.to_string_lossy().into_owned();
+            let resolved = self.paths(None).resolve(pattern).map_err(|e| fail(format!("meshes: {e}")))?;
+            let text = absolute(&resolved).to_string_lossy().into_owned();
             let mut paths: Vec<PathBuf> = glob::glob(&text)
                 .map_err(|e| fail(format!("meshes = \"{pattern}\": not a glob pattern: {e}")))?
                 .filter_map(Result::ok)
@@ -579,7 +592,7 @@ impl ScenarioSpec {
             }
             paths.into_iter().map(|p| (p, Vec::new())).collect()
         } else if let Some(mesh) = &self.mesh {
-            let path = self.paths(None).resolve(mesh).map_err(fail)?;
+            let path = self.paths(None).resolve_existing("mesh", mesh).map_err(fail)?;
             let stem = file_stem(&path);
             let scenario = self.load_file(&path, &self.name, Some(stem), None)?;
             return Ok(Loaded { scenarios: vec![scenario], skipped: Vec::new() });
@@ -617,7 +630,11 @@ impl ScenarioSpec {
 
     /// A survey mesh or procedural look-alike, with the survey edit or the scenario's regions.
     fn load_builtin(&self, source: &DataSource) -> Result<LoadedScenario, HarnessError> {
-        let fail = |message: String| HarnessError::Scenario { scenario: self.name.clone(), message };
+        let fail = |message: String| HarnessError::Scenario {
+            scenario: self.name.clone(),
+            file: Some(self.path.clone()),
+            message,
+        };
         let (mesh, topology, selection, transform, mesh_source) = match (
             source,
             &self.survey,
@@ -680,6 +697,7 @@ impl ScenarioSpec {
             input: None,
             notes: Vec::new(),
             member: None,
+            repaired: None,
         })
     }
 
@@ -691,10 +709,15 @@ impl ScenarioSpec {
         stem: Option<String>,
         member: Option<Member>,
     ) -> Result<LoadedScenario, HarnessError> {
-        let fail = |message: String| HarnessError::Scenario { scenario: name.to_string(), message };
+        let fail = |message: String| HarnessError::Scenario {
+            scenario: name.to_string(),
+            file: Some(self.path.clone()),
+            message,
+        };
         let mut input = meshes::io::read_mesh(path)?;
         let mut notes = Vec::new();
         let mut member = member;
+        let mut repaired_by = None;
         if self.repair {
             // Results are then written with the repaired faces, in the file's vertex order.
             let (repaired, log) = meshes::repair::repair(&input).map_err(|e| e.in_file(path))?;
@@ -703,6 +726,7 @@ impl ScenarioSpec {
                 if let Some(m) = &mut member {
                     m.repaired = Some(log.summary());
                 }
+                repaired_by = Some(Repaired { file: path.to_path_buf(), changes: log.summary() });
             }
             input = repaired;
         }
@@ -756,6 +780,7 @@ impl ScenarioSpec {
             input,
             notes,
             member,
+            repaired: repaired_by,
         })
     }
 
@@ -971,6 +996,11 @@ pub fn survey_edit(
     let step = LoadedStep { handles: HandleSet::new(regions, mesh.n_vertices())?, motions, roles };
     let targets = step.targets(mesh.positions())?;
     Ok((step.handles, targets))
+}
+
+/// `path` made absolute (from the working directory) for a message, as it is if that fails.
+fn absolute(path: &Path) -> PathBuf {
+    std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf())
 }
 
 /// The file name of `path` without its extension, for scenario names and `{stem}`.

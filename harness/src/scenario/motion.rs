@@ -97,7 +97,7 @@ impl TransformSpec {
                     "`def` is a whole transform: give it alone, without rotate, scale or translate".into()
                 );
             }
-            let path = paths.resolve(def)?;
+            let path = paths.resolve_existing("def", def)?;
             let t = meshes::io::read_transform(&path).map_err(|e| e.to_string())?;
             return Ok(Motion::Transform(t));
         }

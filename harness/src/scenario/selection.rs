@@ -59,8 +59,17 @@ impl Axis {
 pub enum Selection {
     /// The vertices with `status` (0 fixed, 1 free, 2 handle) in a survey `.sel` file.
     Sel { file: String, status: u8 },
-    /// The vertices with region id `id` in a libigl `.dmat` (one integer per vertex, -1 free).
-    Dmat { file: String, id: i64 },
+    /// A libigl `.dmat` of one integer column, read as its `form` says: `region_ids` (the default)
+    /// holds one region id per vertex of the mesh file (-1 free) and the region is the vertices of
+    /// id `id`; `indices` lists the region's vertex indices (as libigl writes an index vector such
+    /// as `b`) and takes no `id`.
+    Dmat {
+        file: String,
+        #[serde(default)]
+        id: Option<i64>,
+        #[serde(default)]
+        form: DmatForm,
+    },
     /// These vertex ids (of the input file's vertex order).
     Vertices(Vec<u32>),
     /// The vertex ids listed in a text file (whitespace separated, `#` comments).
@@ -72,6 +81,17 @@ pub enum Selection {
     /// The vertices whose `axis` bbox coordinate lies in `from..=to` (`from = 0, to = 0.05`: the lowest
     /// 5% of the box along the axis).
     Slab { axis: Axis, from: f64, to: f64 },
+}
+
+/// What the integers of a `.dmat` selection are.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DmatForm {
+    /// One region id per vertex of the mesh file, `-1` for none (libigl's ARAP tutorial selections).
+    #[default]
+    RegionIds,
+    /// Vertex indices (libigl's index vectors).
+    Indices,
 }
 
 /// Where the files a scenario names are looked up.
@@ -120,13 +140,35 @@ impl PathContext {
         self.read.push(resolved.clone());
         Ok(resolved)
     }
+
+    /// `written`, the value of the scenario's key `key`, resolved as [`PathContext::resolve`] does,
+    /// when something is there. Otherwise the error names the key, the value as written and the
+    /// absolute path it resolved to (and, for a relative value, the directory it was taken from).
+    pub fn resolve_existing(&self, key: &str, written: &str) -> Result<PathBuf, String> {
+        let path = self.resolve(written).map_err(|e| format!("{key} = \"{written}\": {e}"))?;
+        if path.exists() {
+            return Ok(path);
+        }
+        let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        let relative = !Path::new(written).is_absolute() && !written.starts_with("${");
+        let from = if relative {
+            format!(
+                " (a relative path is taken from the scenario file's directory, {})",
+                absolute(&self.base).display()
+            )
+        } else {
+            String::new()
+        };
+        Err(format!("{key} = \"{written}\": {} does not exist{from}", absolute(&path).display()))
+    }
 }
 
 /// The per-vertex files a region may read, one entry per vertex of the input file.
 pub trait SelectionFiles {
     /// Survey status codes of `file`.
     fn sel(&self, file: &Path) -> Result<Vec<u8>, String>;
-    /// Region ids of the `.dmat` `file`.
+    /// The integers of the one-column `.dmat` `file`, as many as it holds (the caller checks them
+    /// against the mesh).
     fn dmat(&self, file: &Path) -> Result<Vec<i64>, String>;
     /// Vertex ids listed in `file`.
     fn index_list(&self, file: &Path) -> Result<Vec<u32>, String>;
@@ -202,7 +244,7 @@ impl Selection {
         };
         let picked: Vec<u32> = match self {
             Selection::Sel { file, status } => {
-                let path = paths.resolve(file)?;
+                let path = paths.resolve_existing("select.sel.file", file)?;
                 let codes = files.sel(&path)?;
                 let picked =
                     (0..n_input as u32).filter(|&v| codes[v as usize] == *status).collect::<Vec<_>>();
@@ -211,10 +253,32 @@ impl Selection {
                 }
                 picked
             }
-            Selection::Dmat { file, id } => {
-                let path = paths.resolve(file)?;
+            Selection::Dmat { file, id, form } => {
+                let id = match (form, id) {
+                    (DmatForm::RegionIds, Some(id)) => *id,
+                    (DmatForm::RegionIds, None) => {
+                        return Err(format!(
+                            "select.dmat = {{ file = \"{file}\" }}: give `id = N` (the vertices whose region id is N in a \
+                             per-vertex .dmat) or `form = \"indices\"` (the file lists vertex indices)"
+                        ))
+                    }
+                    (DmatForm::Indices, Some(_)) => {
+                        return Err(format!(
+                            "select.dmat = {{ file = \"{file}\", form = \"indices\" }}: an index list takes no `id` \
+                             (`id` picks a region of a per-vertex .dmat of region ids)"
+                        ))
+                    }
+                    (DmatForm::Indices, None) => {
+                        let path = paths.resolve_existing("select.dmat.file", file)?;
+                        return dmat_indices(&files.dmat(&path)?, n_input, &path);
+                    }
+                };
+                let path = paths.resolve_existing("select.dmat.file", file)?;
                 let ids = files.dmat(&path)?;
-                let picked = (0..n_input as u32).filter(|&v| ids[v as usize] == *id).collect::<Vec<_>>();
+                if ids.len() != n_input {
+                    return Err(wrong_length(&ids, n_input, &path, file));
+                }
+                let picked = (0..n_input as u32).filter(|&v| ids[v as usize] == id).collect::<Vec<_>>();
                 if picked.is_empty() {
                     let mut present: Vec<i64> = ids.clone();
                     present.sort();
@@ -228,7 +292,7 @@ impl Selection {
             }
             Selection::Vertices(list) => checked_ids(list.clone(), n_input, "select.vertices")?,
             Selection::VertexFile(file) => {
-                let path = paths.resolve(file)?;
+                let path = paths.resolve_existing("select.vertex_file", file)?;
                 checked_ids(files.index_list(&path)?, n_input, &path.display().to_string())?
             }
             Selection::Box { min, max } => {
@@ -261,6 +325,49 @@ impl Selection {
     }
 }
 
+/// The vertices of the index-list `.dmat` `path` (`values`, of a mesh file of `n` vertices), sorted
+/// and deduplicated. A negative value is an error that says the file looks like a per-vertex one.
+fn dmat_indices(values: &[i64], n: usize, path: &Path) -> Result<Vec<u32>, String> {
+    if let Some(k) = values.iter().position(|&v| v < 0) {
+        let per_vertex = if values.len() == n {
+            format!(
+                "; it has one value per vertex ({n}): a per-vertex .dmat of region ids, selected with \
+                 `id = N` instead of `form = \"indices\"`"
+            )
+        } else {
+            String::new()
+        };
+        return Err(format!(
+            "{} (select.dmat, form = \"indices\"): entry {k} is {}, not a vertex index{per_vertex}",
+            path.display(),
+            values[k]
+        ));
+    }
+    let ids = values.iter().map(|&v| u32::try_from(v).unwrap_or(u32::MAX)).collect();
+    checked_ids(ids, n, &format!("{} (select.dmat, form = \"indices\")", path.display()))
+}
+
+/// The error of a per-vertex `.dmat` (`file` as written, at `path`) whose `values` are not one per
+/// vertex of the mesh file's `n`: when they could be vertex indices of that mesh, it says the file
+/// looks like an index list and names the key that reads it as one.
+fn wrong_length(values: &[i64], n: usize, path: &Path, file: &str) -> String {
+    let head = format!(
+        "{} (select.dmat with `id`): {} values, but a per-vertex .dmat holds one region id for each of the \
+         mesh file's {n} vertices",
+        path.display(),
+        values.len()
+    );
+    let indices = values.len() < n && values.iter().all(|&v| (0..n as i64).contains(&v));
+    if indices {
+        format!(
+            "{head}. Its values are all vertex indices of the mesh, so it looks like an index list (libigl's \
+             other common .dmat): select its vertices with `select = {{ dmat = {{ file = \"{file}\", form = \"indices\" }} }}`"
+        )
+    } else {
+        format!("{head} (nor are its values all vertex indices of the mesh, as an index list's, `form = \"indices\"`, would be)")
+    }
+}
+
 /// `ids` sorted and deduplicated, each below `n`; `what` names the source in errors.
 fn checked_ids(mut ids: Vec<u32>, n: usize, what: &str) -> Result<Vec<u32>, String> {
     if let Some(bad) = ids.iter().find(|&&v| v as usize >= n) {
@@ -290,8 +397,8 @@ mod tests {
         fn sel(&self, _: &Path) -> Result<Vec<u8>, String> {
             Ok(vec![0, 2, 1, 2])
         }
-        fn dmat(&self, _: &Path) -> Result<Vec<i64>, String> {
-            Ok(vec![-1, 0, 0, 1])
+        fn dmat(&self, file: &Path) -> Result<Vec<i64>, String> {
+            Ok(if file.ends_with("x.dmat") { vec![-1, 0, 0, 1] } else { vec![3, 1, 3] })
         }
         fn index_list(&self, _: &Path) -> Result<Vec<u32>, String> {
             Ok(vec![3, 1, 3])
@@ -303,11 +410,17 @@ mod tests {
         (0..4).map(|i| [i as f64, 0.0, 0.0]).collect()
     }
 
+    /// `s` on [`line`], its files (read by [`NoFiles`]) present, empty, in a fresh directory.
     fn pick(s: &Selection, input: &InputIndex) -> Result<Vec<u32>, String> {
+        let dir = tempfile::tempdir().unwrap();
+        for file in ["x.sel", "x.dmat", "ids.txt", "b.dmat"] {
+            std::fs::write(dir.path().join(file), "").unwrap();
+        }
+        let base = dir.path().to_path_buf();
         s.vertices(
             &line(),
             input,
-            &PathContext { base: "/data".into(), stem: Some("knight".into()), read: FilesRead::default() },
+            &PathContext { base, stem: Some("knight".into()), read: FilesRead::default() },
             &NoFiles,
         )
     }
@@ -334,13 +447,36 @@ mod tests {
         let input = InputIndex { kept_of_input: vec![Some(0), None, Some(1), Some(2)] };
         let handle = Selection::Sel { file: "x.sel".into(), status: 2 };
         assert_eq!(pick(&handle, &input).unwrap(), vec![2], "input 1 dropped, input 3 is mesh 2");
-        let region = Selection::Dmat { file: "x.dmat".into(), id: 0 };
+        let dmat =
+            |file: &str, id: Option<i64>, form: DmatForm| Selection::Dmat { file: file.into(), id, form };
+        let region = dmat("x.dmat", Some(0), DmatForm::RegionIds);
         assert_eq!(pick(&region, &input).unwrap(), vec![1]);
-        let missing = Selection::Dmat { file: "x.dmat".into(), id: 7 };
+        let missing = dmat("x.dmat", Some(7), DmatForm::RegionIds);
         assert!(pick(&missing, &input).unwrap_err().contains("ids present: [-1, 0, 1]"));
+        // An index list (3, 1, 3): input 1 was dropped, input 3 is mesh vertex 2.
+        assert_eq!(pick(&dmat("b.dmat", None, DmatForm::Indices), &input).unwrap(), vec![2]);
         assert_eq!(pick(&Selection::VertexFile("ids.txt".into()), &input).unwrap(), vec![2]);
         let only_dropped = Selection::Vertices(vec![1]);
         assert!(pick(&only_dropped, &input).unwrap_err().contains("no face uses"));
+    }
+
+    #[test]
+    fn a_dmat_read_the_wrong_way_says_which_form_it_looks_like() {
+        let all = InputIndex::identity(4);
+        let dmat =
+            |file: &str, id: Option<i64>, form: DmatForm| Selection::Dmat { file: file.into(), id, form };
+        // Three values on a four-vertex mesh, each a vertex index: an index list read as region ids.
+        let e = pick(&dmat("b.dmat", Some(1), DmatForm::RegionIds), &all).unwrap_err();
+        assert!(e.contains("b.dmat") && e.contains("3 values") && e.contains("4 vertices"), "{e}");
+        assert!(e.contains("looks like an index list"), "{e}");
+        assert!(e.contains("select = { dmat = { file = \"b.dmat\", form = \"indices\" } }"), "{e}");
+        // One value per vertex with a -1: region ids read as an index list.
+        let e = pick(&dmat("x.dmat", None, DmatForm::Indices), &all).unwrap_err();
+        assert!(e.contains("entry 0 is -1") && e.contains("`id = N`"), "{e}");
+        let e = pick(&dmat("x.dmat", None, DmatForm::RegionIds), &all).unwrap_err();
+        assert!(e.contains("give `id = N`") && e.contains("form = \"indices\""), "{e}");
+        let e = pick(&dmat("b.dmat", Some(1), DmatForm::Indices), &all).unwrap_err();
+        assert!(e.contains("takes no `id`"), "{e}");
     }
 
     #[test]
@@ -364,5 +500,11 @@ mod tests {
         assert!(e.contains("DEFORMBENCH_TEST_UNSET_VARIABLE"), "{e}");
         let no_stem = PathContext { base: ".".into(), stem: None, read: FilesRead::default() };
         assert!(no_stem.resolve("{stem}.sel").unwrap_err().contains("needs a mesh file"));
+        let e = ctx.resolve_existing("select.dmat.file", "sel/{stem}.dmat").unwrap_err();
+        assert_eq!(
+            e,
+            "select.dmat.file = \"sel/{stem}.dmat\": /configs/real/sel/knight.dmat does not exist \
+             (a relative path is taken from the scenario file's directory, /configs/real)"
+        );
     }
 }

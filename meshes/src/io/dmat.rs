@@ -1,4 +1,6 @@
-//! libigl's dense matrix text format (`.dmat`), as its tutorials use for per-vertex selections.
+//! libigl's dense matrix text format (`.dmat`), as its tutorials use for per-vertex selections
+//! (one region id per vertex, [`read_dmat_column`]) and for lists of vertex indices
+//! ([`read_dmat_integers`]).
 //!
 //! ```text
 //! 1 4        # first line: #columns #rows
@@ -92,6 +94,28 @@ fn parse_column(text: &str, n_vertices: usize) -> Result<Vec<i64>> {
     }
     if rows != n_vertices {
         return Err(MeshError::LengthMismatch { what: ".dmat column", got: rows, expected: n_vertices });
+    }
+    Ok(values)
+}
+
+/// Read the `.dmat` file `path` of one column (or one row) of integers, of any length: a per-vertex
+/// column of region ids whose length the caller checks against its mesh, or a list of vertex
+/// indices (as libigl writes an index vector, e.g. the constrained vertices `b`).
+///
+/// Errors (all wrapped in [`MeshError::InFile`]): those of [`read_dmat`]; [`MeshError::Syntax`] with
+/// the line for a value that is not an integer; [`MeshError::Invalid`] for a matrix of more than one
+/// column and more than one row.
+pub fn read_dmat_integers(path: impl AsRef<Path>) -> Result<Vec<i64>> {
+    let path = path.as_ref();
+    read_dmat_text(path).and_then(|text| parse_integers(&text)).map_err(|e| e.in_file(path))
+}
+
+fn parse_integers(text: &str) -> Result<Vec<i64>> {
+    let (rows, cols, values) = parse_values(text, |token| token.parse::<i64>().ok(), "an integer")?;
+    if cols != 1 && rows != 1 {
+        return Err(MeshError::Invalid(format!(
+            "expected one column or one row of integers, the header announces {cols} columns of {rows} rows"
+        )));
     }
     Ok(values)
 }
@@ -193,5 +217,15 @@ mod tests {
         let e = parse_column("1 3\n0 0 0\n", 4).unwrap_err();
         assert!(matches!(e, MeshError::LengthMismatch { got: 3, expected: 4, .. }), "{e:?}");
         assert_eq!(parse_column("1 3\n-1 0\n7\n", 3).unwrap(), vec![-1, 0, 7]);
+    }
+
+    #[test]
+    fn integers_are_one_column_or_one_row_of_any_length() {
+        assert_eq!(parse_integers("1 3\n12\n-1\n7\n").unwrap(), vec![12, -1, 7]);
+        assert_eq!(parse_integers("2 1\n4 5\n").unwrap(), vec![4, 5]);
+        let e = parse_integers("2 2\n0 1 2 3\n").unwrap_err();
+        assert!(matches!(e, MeshError::Invalid(_)) && e.to_string().contains("2 columns of 2 rows"), "{e}");
+        let e = parse_integers("1 2\n3\n4.5\n").unwrap_err();
+        assert!(matches!(e, MeshError::Syntax { line: 3, .. }), "{e:?}");
     }
 }

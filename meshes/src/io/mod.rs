@@ -8,7 +8,7 @@
 //! | glTF 2.0 (`.gltf`, `.glb`) | [`read_gltf`] | [`write_glb`] (binary only, `f32` positions) | [`gltf`] |
 //! | survey selection (`.sel`) | [`read_selection`] | [`write_selection`] | [`survey`] |
 //! | survey handle transform (`.def`) | [`read_transform`] | [`write_transform`] | [`survey`] |
-//! | libigl dense matrix (`.dmat`, text), e.g. a per-vertex selection column | [`read_dmat`], [`read_dmat_column`] | — | [`dmat`] |
+//! | libigl dense matrix (`.dmat`, text), e.g. a per-vertex selection column or an index list | [`read_dmat`], [`read_dmat_column`], [`read_dmat_integers`] | — | [`dmat`] |
 //! | vertex-id list (0-based ids, `#` comments) | [`read_index_list`] | — | [`index_list`] |
 //!
 //! [`read_mesh`] and [`write_mesh`] choose among the mesh formats by extension. Faces of more than 3
@@ -36,7 +36,7 @@ pub mod polygon;
 pub mod survey;
 
 pub use self::gltf::{encode_glb, read_gltf, write_glb};
-pub use dmat::{read_dmat, read_dmat_column, DenseMatrix};
+pub use dmat::{read_dmat, read_dmat_column, read_dmat_integers, DenseMatrix};
 pub use index_list::read_index_list;
 pub use obj::{parse_obj, read_obj, write_obj};
 pub use off::{parse_off, read_off, write_off};

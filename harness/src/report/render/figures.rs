@@ -641,6 +641,7 @@ mod tests {
             input: None,
             notes: Vec::new(),
             member: None,
+            repaired: None,
         }
     }
 
