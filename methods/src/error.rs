@@ -7,8 +7,13 @@ use crate::linalg::sparse_cholesky::SolverError;
 pub enum MethodError {
     #[error("unknown method `{name}`; known methods: {}", known.join(", "))]
     UnknownMethod { name: String, known: Vec<&'static str> },
+    /// A parameter table that does not parse (an unknown key, a value of the wrong type).
     #[error("parameters of `{method}`: {message}")]
     Parameters { method: &'static str, message: String },
+    /// Parameters that parse but break their rules: exactly the keys and values at fault
+    /// ([`crate::params::ParamCheck`]), e.g. `arap: tolerance = NaN: must be a finite number >= 0`.
+    #[error("{method}: {}", faults.iter().map(ToString::to_string).collect::<Vec<_>>().join("; "))]
+    InvalidParameters { method: &'static str, faults: Vec<crate::params::InvalidParameter> },
     #[error("handle set: {0}")]
     Handles(String),
     #[error("handle targets: {0}")]
