@@ -142,9 +142,21 @@ pub fn create(name: &str, params: &toml::Table) -> Result<Box<dyn DeformationMet
 }
 
 fn parse<P: DeserializeOwned>(method: &'static str, table: &toml::Table) -> Result<P, MethodError> {
-    toml::Value::Table(table.clone())
-        .try_into()
-        .map_err(|e: toml::de::Error| MethodError::Parameters { method, message: e.message().to_string() })
+    toml::Value::Table(table.clone()).try_into().map_err(|e: toml::de::Error| {
+        // The message of a value of the wrong type does not say whose it is: name the keys that
+        // fail on their own, with their values.
+        let alone = |key: &String, value: &toml::Value| {
+            let one = toml::Table::from_iter([(key.clone(), value.clone())]);
+            toml::Value::Table(one).try_into::<P>().is_err()
+        };
+        let faulty: Vec<String> =
+            table.iter().filter(|(k, v)| alone(k, v)).map(|(k, v)| format!("{k} = {v}")).collect();
+        let message = match faulty.is_empty() {
+            true => e.message().to_string(),
+            false => format!("{}: {}", faulty.join(", "), e.message()),
+        };
+        MethodError::Parameters { method, message }
+    })
 }
 
 #[cfg(test)]

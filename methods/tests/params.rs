@@ -87,6 +87,13 @@ fn two_bad_keys_are_both_named_and_nothing_else() {
     assert_eq!(faults.iter().flat_map(|f| f.keys()).collect::<Vec<_>>(), ["tolerance", "lbfgs_memory"]);
 }
 
+#[test]
+fn a_value_of_the_wrong_type_names_its_key() {
+    let e = error("arap", "tolerance = \"small\"\nmax_iterations = 10").to_string();
+    assert!(e.starts_with("parameters of `arap`: tolerance = \"small\": "), "{e}");
+    assert!(!e.contains("max_iterations"), "{e}");
+}
+
 /// Every key of `method`, from the parse error of an unknown one (`expected one of ...`).
 fn keys_of(method: &str) -> Vec<String> {
     let message = error(method, "no_such_key = 1").to_string();
