@@ -53,6 +53,8 @@ enum Command {
         /// the result meshes) for `merge`; no plots, figures or regression check.
         #[arg(long, value_name = "K/N")]
         shard: Option<Shard>,
+        #[command(flatten)]
+        force: Force,
     },
     /// Combine the partial reports of `all --shard K/N` (one directory each, K = 1..N) into the
     /// report one run would have written, ending with the regression check.
@@ -84,6 +86,8 @@ enum Command {
         peers: Peers,
         #[command(flatten)]
         meshes: Meshes,
+        #[command(flatten)]
+        force: Force,
     },
     /// Compare reports/results.json with the baseline; exit non-zero naming every regression.
     Check {
@@ -213,6 +217,15 @@ impl Peers {
 }
 
 #[derive(Args, Clone)]
+struct Force {
+    /// Run scenarios whose estimated memory (the mesh after `refine`, or `vertices`, times what its
+    /// methods need per vertex) exceeds the memory available (MemAvailable); without it they are
+    /// refused, exit code 2, before their mesh is loaded.
+    #[arg(long)]
+    force: bool,
+}
+
+#[derive(Args, Clone)]
 struct Gate {
     /// The regression baseline [default: reports/baselines/survey.json in the workspace for a run on
     /// the survey data, reports/baselines/procedural.json for one on the procedural look-alikes].
@@ -306,6 +319,7 @@ impl Common {
             command_line: command_line.to_vec(),
             repetitions: self.repeat as usize,
             progress: !self.quiet,
+            force: false,
         }
     }
 }
@@ -341,8 +355,9 @@ where
     let command_line: Vec<String> = args.iter().map(|a| a.to_string_lossy().into_owned()).collect();
     let cli = Cli::parse_from(args);
     match cli.command {
-        Command::All { common, peers, meshes, gate, no_check, shard } => {
+        Command::All { common, peers, meshes, gate, no_check, shard, force } => {
             let mut options = common.options(Vec::new(), Vec::new(), &command_line);
+            options.force = force.force;
             options.python = peers.python_path();
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
@@ -369,8 +384,9 @@ where
             let publish = PublishOptions { peer_python: None, meshes: meshes.output() };
             publish_and_print(&staged_options, staging, run, &publish, gate)
         }
-        Command::Run { methods, scenario, common, peers, meshes } => {
+        Command::Run { methods, scenario, common, peers, meshes, force } => {
             let mut options = common.options(vec![scenario], methods, &command_line);
+            options.force = force.force;
             options.python = peers.python_path();
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));

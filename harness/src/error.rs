@@ -18,4 +18,8 @@ pub enum HarnessError {
     Io { path: PathBuf, error: std::io::Error },
     #[error("{0}")]
     Report(String),
+    /// A scenario whose estimated memory exceeds what the machine has available, refused before
+    /// its mesh was loaded (`--force` runs it anyway).
+    #[error(transparent)]
+    Memory(#[from] Box<crate::memory::MemoryRefusal>),
 }
