@@ -1,30 +1,13 @@
 //! Checking a method's parameters one key at a time, so an error names exactly the key(s) and
 //! value(s) at fault and the rule they break (`tolerance = NaN: must be a finite number >= 0`),
-//! not every rule of the method. Every `f64` rule asks for a finite number: NaN compares false
-//! with everything, so a rule written `!(x >= 0.0)` alone would pass it in one place and not in
-//! another.
+//! not every rule of the method. Every `f64` rule asks for a finite number and says what it
+//! accepts, so NaN (which fails every comparison, and so passes a rule written as what it refuses,
+//! `x < 0`) and infinity are refused for every float parameter.
 
 use std::fmt::Display;
 
+pub use crate::error::InvalidParameter;
 use crate::error::MethodError;
-
-/// One rule that the values of some parameters break: each key with its value as given, and the
-/// rule.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{}: {rule}", values.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", "))]
-pub struct InvalidParameter {
-    /// The keys at fault with their values (one key for most rules; two for a rule between them).
-    pub values: Vec<(&'static str, String)>,
-    /// What the value must be (`must be >= 1`).
-    pub rule: String,
-}
-
-impl InvalidParameter {
-    /// The keys at fault.
-    pub fn keys(&self) -> Vec<&'static str> {
-        self.values.iter().map(|(k, _)| *k).collect()
-    }
-}
 
 /// The faults found so far; [`ParamCheck::finish`] turns them into
 /// [`MethodError::InvalidParameters`].
