@@ -461,7 +461,8 @@ impl BadInputFixture {
     }
 
     /// Run `all`; it must fail with a message containing every one of `needles`, and write nothing.
-    fn expect_error(&self, needles: &[&str]) {
+    /// The message.
+    fn expect_error(&self, needles: &[&str]) -> String {
         let result = run(&[
             "all",
             "--quiet",
@@ -479,6 +480,7 @@ impl BadInputFixture {
         let written: Vec<_> =
             std::fs::read_dir(&self.reports).unwrap().map(|e| e.unwrap().file_name()).collect();
         assert_eq!(written, vec![std::ffi::OsString::from("sentinel.txt")], "reports/ was written to");
+        message
     }
 }
 
@@ -611,6 +613,24 @@ fn unknown_method_parameter_is_rejected() {
     let f = BadInputFixture::new();
     std::fs::write(f.configs.join("methods.toml"), "[arap]\nmax_iter = 3\n").unwrap();
     f.expect_error(&["methods.toml", "max_iter"]);
+}
+
+/// Issue 60: the key and value at fault, not every rule of the method.
+#[test]
+fn a_bad_method_parameter_names_its_file_key_and_value_alone() {
+    let f = BadInputFixture::new();
+    std::fs::write(f.configs.join("methods.toml"), "[arap]\ntolerance = nan\n").unwrap();
+    let message = f.expect_error(&["methods.toml: arap: tolerance = NaN: must be a finite number >= 0"]);
+    assert!(!message.contains("lbfgs") && !message.contains("max_iterations"), "{message}");
+    std::fs::write(
+        f.configs.join("methods.toml"),
+        "[scale_aware]\nrefactor_turn = -0.5\nnormal_sweeps = 0\n",
+    )
+    .unwrap();
+    let message = f.expect_error(&[
+        "methods.toml: scale_aware: normal_sweeps = 0: must be >= 1; refactor_turn = -0.5: must be a finite number >= 0",
+    ]);
+    assert!(!message.contains("constraint_weight") && !message.contains("anderson_depth"), "{message}");
 }
 
 #[test]

@@ -53,6 +53,8 @@ enum Command {
         /// the result meshes) for `merge`; no plots, figures or regression check.
         #[arg(long, value_name = "K/N")]
         shard: Option<Shard>,
+        #[command(flatten)]
+        force: Force,
     },
     /// Combine the partial reports of `all --shard K/N` (one directory each, K = 1..N) into the
     /// report one run would have written, ending with the regression check.
@@ -86,6 +88,8 @@ enum Command {
         peers: Peers,
         #[command(flatten)]
         meshes: Meshes,
+        #[command(flatten)]
+        force: Force,
     },
     /// Compare reports/results.json with the baseline; exit non-zero naming every regression.
     Check {
@@ -231,6 +235,15 @@ impl Peers {
 }
 
 #[derive(Args, Clone)]
+struct Force {
+    /// Run scenarios whose estimated memory (the mesh after `refine`, or `vertices`, times what its
+    /// methods need per vertex) exceeds the memory available (MemAvailable); without it they are
+    /// refused, exit code 2, before their mesh is loaded.
+    #[arg(long)]
+    force: bool,
+}
+
+#[derive(Args, Clone)]
 struct Gate {
     /// The regression baseline [default: the committed reports/baselines/survey.json beside the
     /// configuration (./ or built in) for a run on the survey data, procedural.json for one on the
@@ -341,6 +354,7 @@ impl Common {
             command_line: command_line.to_vec(),
             repetitions: self.repeat as usize,
             progress: !self.quiet,
+            force: false,
         })
     }
 }
@@ -376,8 +390,9 @@ where
     let command_line: Vec<String> = args.iter().map(|a| a.to_string_lossy().into_owned()).collect();
     let cli = Cli::parse_from(args);
     match cli.command {
-        Command::All { common, peers, meshes, gate, no_check, shard } => {
+        Command::All { common, peers, meshes, gate, no_check, shard, force } => {
             let mut options = common.options(Vec::new(), Vec::new(), &command_line)?;
+            options.force = force.force;
             options.python = peers.python_path();
             let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
             options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
@@ -404,8 +419,9 @@ where
             let publish = PublishOptions { peer_python: None, meshes: meshes.output() };
             publish_and_print(&staged_options, staging, run, &publish, gate)
         }
-        Command::Run { methods, scenarios, common, peers, meshes } => {
+        Command::Run { methods, scenarios, common, peers, meshes, force } => {
             let mut options = common.options(scenarios, methods, &command_line)?;
+            options.force = force.force;
             if options.methods.is_empty() {
                 suite::require_listed_methods(&options)?;
             }

@@ -632,6 +632,33 @@ mod tests {
     }
 
     #[test]
+    fn a_bad_parameter_names_its_file_key_and_value_alone() {
+        // configs/methods.toml
+        let dir = tempfile::tempdir().unwrap();
+        let methods = dir.path().join("methods.toml");
+        std::fs::write(&methods, "[arap]\ntolerance = nan\n").unwrap();
+        let e = MethodCatalog::load(&methods).unwrap_err().to_string();
+        assert_eq!(e, format!("{}: arap: tolerance = NaN: must be a finite number >= 0", methods.display()));
+        // A --methods file's variant.
+        std::fs::write(&methods, "[arap]\nmax_iterations = 100\n").unwrap();
+        let mut catalog = MethodCatalog::load(&methods).unwrap();
+        let mine = dir.path().join("mine.toml");
+        std::fs::write(&mine, "[sa]\nmethod = \"scale_aware\"\nparams = { normal_sweeps = 0 }\n").unwrap();
+        let e = catalog.add_method_file(&mine, &[]).unwrap_err().to_string();
+        assert_eq!(e, format!("{}: [sa]: scale_aware: normal_sweeps = 0: must be >= 1", mine.display()));
+        // A sweep point.
+        let sweeps = dir.path().join("sweeps.toml");
+        std::fs::write(
+            &sweeps,
+            "[turns]\nmethod = \"scale_aware\"\nparams = { refactor_turn = [0.1, -0.5] }\n",
+        )
+        .unwrap();
+        let e = catalog.add_sweeps(&sweeps).unwrap_err().to_string();
+        assert!(e.starts_with(&format!("{}: [turns]: ", sweeps.display())), "{e}");
+        assert!(e.ends_with("scale_aware: refactor_turn = -0.5: must be a finite number >= 0"), "{e}");
+    }
+
+    #[test]
     fn bad_external_entries_are_named() {
         let err = load("[m]\ncommand = []\n").unwrap_err();
         assert!(err.contains("[m]") && err.contains("non-empty list"), "{err}");

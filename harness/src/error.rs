@@ -19,6 +19,10 @@ pub enum HarnessError {
     Io { path: PathBuf, error: std::io::Error },
     #[error("{0}")]
     Report(String),
+    /// A scenario whose estimated memory exceeds what the machine has available, refused before
+    /// its mesh was loaded (`--force` runs it anyway).
+    #[error(transparent)]
+    Memory(#[from] Box<crate::memory::MemoryRefusal>),
 }
 
 /// ` (did you mean `x`?)` when one of `known` is a likely misspelling of `name` (the nearest by

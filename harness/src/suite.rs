@@ -8,13 +8,14 @@ use std::sync::OnceLock;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::case::{run_case, CaseSettings, Reference};
-use crate::config::{MethodCatalog, PeerSetup};
+use crate::config::{ConfiguredMethod, Implementation, MethodCatalog, PeerSetup};
 use crate::error::HarnessError;
 use crate::metrics::RestGeometry;
 use crate::provenance::Provenance;
 use crate::record::{CaseResult, REFERENCE_METHOD};
 use crate::scenario::{
-    load_spec, load_specs, DataSource, LoadedScenario, ScenarioSpec, SkippedInput, FILE_SOURCE,
+    load_spec, load_specs, DataSource, LoadedScenario, ScenarioSpec, SizeCheck, SizeRequest, SkippedInput,
+    FILE_SOURCE,
 };
 use crate::shard::{assign, estimated_cost, Shard};
 use crate::verdict::VerdictRules;
@@ -50,6 +51,9 @@ pub struct SuiteOptions {
     /// The command that asked for the run, for its record.
     pub command_line: Vec<String>,
     pub progress: bool,
+    /// Run scenarios whose estimated memory exceeds the available memory (`--force`); otherwise
+    /// they are refused before their mesh is loaded ([`crate::memory`]).
+    pub force: bool,
 }
 
 /// Results of a run, with the scenarios they were computed on.
@@ -172,6 +176,12 @@ pub struct Prepared {
 /// Load and validate the configuration (`methods.toml`, the peers when asked for, `verdicts.toml`)
 /// and every selected scenario.
 pub fn prepare(options: &SuiteOptions) -> Result<Prepared, HarnessError> {
+    prepare_within(options, false)
+}
+
+/// [`prepare`], with each scenario's estimated memory checked against the available memory before
+/// its mesh is made or read, when `check_memory` and not `options.force` ([`memory_check`]).
+fn prepare_within(options: &SuiteOptions, check_memory: bool) -> Result<Prepared, HarnessError> {
     let catalog = load_catalog(options)?;
     let rules = VerdictRules::load(&options.configs_dir.join("verdicts.toml"))?;
     for m in &options.methods {
@@ -214,8 +224,11 @@ pub fn prepare(options: &SuiteOptions) -> Result<Prepared, HarnessError> {
     let source = options.data_source()?;
     let mut scenarios = Vec::with_capacity(specs.len());
     let mut skipped = Vec::new();
+    let no_check = |_: &SizeRequest| Ok(());
+    let by_memory = |request: &SizeRequest| memory_check(options, &catalog, request);
+    let check: SizeCheck = if check_memory && !options.force { &by_memory } else { &no_check };
     for spec in &specs {
-        let loaded = spec.load(&source)?;
+        let loaded = spec.load_checked(&source, check)?;
         scenarios.extend(loaded.scenarios);
         skipped.extend(loaded.skipped);
     }
@@ -347,29 +360,59 @@ fn select_specs(options: &SuiteOptions) -> Result<Vec<ScenarioSpec>, HarnessErro
 fn plan(options: &SuiteOptions, catalog: &MethodCatalog, scenarios: &[LoadedScenario]) -> Vec<Vec<String>> {
     scenarios
         .iter()
-        .map(|s| {
-            let name = &s.spec.name;
-            catalog
-                .methods()
-                .iter()
-                .filter(|m| match &s.spec.methods {
-                    Some(list) => list.contains(&m.name),
-                    None => m.runs_on.as_ref().is_none_or(|on| on.contains(name)),
-                })
-                .filter(|m| !s.spec.left_out.contains_key(&m.name) && m.unavailable.is_none())
-                .map(|m| m.name.as_str())
-                .filter(|m| options.methods.is_empty() || options.methods.iter().any(|x| x == m))
-                .map(str::to_string)
-                .collect()
-        })
+        .map(|s| planned_methods(options, catalog, &s.spec, &s.spec.name).map(|m| m.name.clone()).collect())
         .collect()
+}
+
+/// The methods [`plan`] gives the scenario `name` of `spec` (a collection's member has its own name).
+fn planned_methods<'a>(
+    options: &'a SuiteOptions,
+    catalog: &'a MethodCatalog,
+    spec: &'a ScenarioSpec,
+    name: &'a str,
+) -> impl Iterator<Item = &'a ConfiguredMethod> + 'a {
+    catalog
+        .methods()
+        .iter()
+        .filter(move |m| match &spec.methods {
+            Some(list) => list.contains(&m.name),
+            None => m.runs_on.as_ref().is_none_or(|on| on.iter().any(|s| s == name)),
+        })
+        .filter(move |m| !spec.left_out.contains_key(&m.name) && m.unavailable.is_none())
+        .filter(move |m| options.methods.is_empty() || options.methods.iter().any(|x| *x == m.name))
+}
+
+/// Refuse the mesh size `request` when the scenario's estimated memory ([`crate::memory::estimate`]:
+/// the mesh and its planned built-in methods; an external method's memory is its own process's
+/// and unknown here) exceeds the memory available now. `MemAvailable` is read at each request, so
+/// the meshes already loaded count against it.
+fn memory_check(
+    options: &SuiteOptions,
+    catalog: &MethodCatalog,
+    request: &SizeRequest,
+) -> Result<(), HarnessError> {
+    let methods: Vec<(String, u64)> = planned_methods(options, catalog, request.spec, request.scenario)
+        .filter_map(|m| match &m.implementation {
+            Implementation::BuiltIn(entry) => Some((m.name.clone(), entry.bytes_per_vertex)),
+            Implementation::External(_) => None,
+        })
+        .collect();
+    let estimate = crate::memory::estimate(request.vertices, request.faces, &methods, options.jobs);
+    crate::memory::MemoryRefusal::check(
+        estimate,
+        crate::memory::available_bytes(),
+        request.spec.path.clone(),
+        request.key.clone(),
+        request.mesh.clone(),
+    )
+    .map_err(|refusal| HarnessError::Memory(Box::new(refusal)))
 }
 
 /// Run every selected method on every scenario. [`REFERENCE_METHOD`] runs first in each scenario so
 /// the others can be compared with it; results are reported in registry order.
 pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
     let mut provenance = record_of(options);
-    let Prepared { config, scenarios, skipped, source } = prepare(options)?;
+    let Prepared { config, scenarios, skipped, source } = prepare_within(options, true)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let plan = plan(options, &config.catalog, &scenarios);
     let results = run_plan(options, &config, &scenarios, &plan)?;
@@ -382,7 +425,7 @@ pub fn run(options: &SuiteOptions) -> Result<SuiteRun, HarnessError> {
 /// Run the scenarios of part `shard` of the suite ([`crate::shard::assign`] on their estimated cost).
 pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, HarnessError> {
     let mut provenance = record_of(options);
-    let Prepared { config, scenarios, skipped, source } = prepare(options)?;
+    let Prepared { config, scenarios, skipped, source } = prepare_within(options, true)?;
     provenance.inputs = crate::provenance::hash_inputs(inputs_of(options, &scenarios));
     let data_source = describe_data(&source, &scenarios);
     let plan = plan(options, &config.catalog, &scenarios);

@@ -7,8 +7,13 @@ use crate::linalg::sparse_cholesky::SolverError;
 pub enum MethodError {
     #[error("unknown method `{name}`; known methods: {}", known.join(", "))]
     UnknownMethod { name: String, known: Vec<&'static str> },
+    /// A parameter table that does not parse (an unknown key, a value of the wrong type).
     #[error("parameters of `{method}`: {message}")]
     Parameters { method: &'static str, message: String },
+    /// Parameters that parse but break their rules: exactly the keys and values at fault
+    /// ([`crate::params::ParamCheck`]), e.g. `arap: tolerance = NaN: must be a finite number >= 0`.
+    #[error("{method}: {}", faults.iter().map(ToString::to_string).collect::<Vec<_>>().join("; "))]
+    InvalidParameters { method: &'static str, faults: Vec<InvalidParameter> },
     #[error("handle set: {0}")]
     Handles(String),
     #[error("handle targets: {0}")]
@@ -49,5 +54,23 @@ impl From<crate::operators::IntrinsicDelaunayError> for MethodError {
 impl From<SolverError> for MethodError {
     fn from(e: SolverError) -> Self {
         MethodError::Solver(e)
+    }
+}
+
+/// One rule that the values of some parameters break: each key with its value as given, and the
+/// rule.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{}: {rule}", values.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", "))]
+pub struct InvalidParameter {
+    /// The keys at fault with their values (one key for most rules; two for a rule between them).
+    pub values: Vec<(&'static str, String)>,
+    /// What the value must be (`must be >= 1`).
+    pub rule: String,
+}
+
+impl InvalidParameter {
+    /// The keys at fault.
+    pub fn keys(&self) -> Vec<&'static str> {
+        self.values.iter().map(|(k, _)| *k).collect()
     }
 }

@@ -46,6 +46,7 @@ use crate::method::{
     Phase, SolveSummary,
 };
 use crate::operators::{laplacian, LaplacianWeights};
+use crate::params::ParamCheck;
 
 /// Parameters of [`LaplacianEditing`] (configs/methods.toml, section `[laplacian]`).
 #[derive(Clone, Debug, Deserialize)]
@@ -66,6 +67,18 @@ pub struct LaplacianParams {
     pub anderson_depth: usize,
     /// How `delta(X)` turns with the surface ([`DeltaFrame`]).
     pub delta_frame: DeltaFrame,
+}
+
+impl LaplacianParams {
+    /// Every key whose value breaks its rule, with that value ([`ParamCheck`]).
+    pub fn validate(&self) -> Result<(), MethodError> {
+        ParamCheck::new()
+            .number_above("omega", self.omega, 0.0)
+            .count_at_least("max_iterations", self.max_iterations, 1)
+            .number_at_least("tolerance", self.tolerance, 0.0)
+            .count_at_most("anderson_depth", self.anderson_depth, MAX_DEPTH)
+            .finish(crate::keys::method_name::LAPLACIAN)
+    }
 }
 
 impl Default for LaplacianParams {
@@ -106,18 +119,7 @@ pub struct LaplacianEditing {
 impl LaplacianEditing {
     /// A method with the given parameters; call [`DeformationMethod::precompute`] next.
     pub fn new(params: LaplacianParams) -> Result<Self, MethodError> {
-        if !(params.omega > 0.0)
-            || params.max_iterations == 0
-            || !(params.tolerance >= 0.0)
-            || params.anderson_depth > MAX_DEPTH
-        {
-            return Err(MethodError::Parameters {
-                method: "laplacian",
-                message: format!(
-                    "omega must be > 0, max_iterations >= 1, tolerance >= 0, anderson_depth <= {MAX_DEPTH}"
-                ),
-            });
-        }
+        params.validate()?;
         Ok(Self {
             params,
             rest: None,

@@ -14,6 +14,7 @@ pub mod laplacian_coordinates;
 pub mod linalg;
 pub mod method;
 pub mod operators;
+pub mod params;
 pub mod registry;
 pub mod rotation_fit;
 pub mod scale_aware;

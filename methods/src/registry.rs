@@ -30,6 +30,13 @@ pub struct MethodEntry {
     /// `total_s / (#V / 1000)` over the four survey tests of a `harness all` on the project's 2-core
     /// machine (at 11f8f45).
     pub seconds_per_kilovertex: f64,
+    /// Its memory, bytes per vertex: what a case of it adds at its peak (`peak_memory_mib`) over the
+    /// mesh's vertex count, at the largest size measured (docs/results.md, "The large real tier":
+    /// igea at 2.1M vertices, 8cb439f; `spectral_mhb` from the bar at 1M after 793b558 cut its
+    /// peak 2.4-fold; `scale_aware*` from igea at 134K, the largest it runs at). The harness refuses
+    /// a scenario whose estimate exceeds the machine's available memory before loading its mesh
+    /// (`--force` runs it anyway).
+    pub bytes_per_vertex: u64,
     /// Its side of HIRM's Table 1 (Wu et al. 2015), if it is one of the two compared there.
     pub table1: Option<Table1Side>,
 }
@@ -53,6 +60,7 @@ pub const METHODS: &[MethodEntry] = &[
         create: |p| Ok(Box::new(LaplacianEditing::new(parse(LAPLACIAN, p)?)?)),
         iterative: true,
         seconds_per_kilovertex: 0.10,
+        bytes_per_vertex: 7_600, // 15.1 GiB at 2.1M
         table1: None,
     },
     MethodEntry {
@@ -61,6 +69,7 @@ pub const METHODS: &[MethodEntry] = &[
         create: |p| Ok(Box::new(Arap::new(parse(ARAP, p)?)?)),
         iterative: true,
         seconds_per_kilovertex: 0.25,
+        bytes_per_vertex: 3_200, // 6.33 GiB at 2.1M
         table1: None,
     },
     MethodEntry {
@@ -69,6 +78,7 @@ pub const METHODS: &[MethodEntry] = &[
         create: |p| Ok(Box::new(Hirm::new(parse(HIRM, p)?)?)),
         iterative: true,
         seconds_per_kilovertex: 0.043,
+        bytes_per_vertex: 3_300, // 6.58 GiB at 2.1M
         table1: Some(Table1Side::HandleIndependent),
     },
     MethodEntry {
@@ -77,6 +87,7 @@ pub const METHODS: &[MethodEntry] = &[
         create: |p| Ok(Box::new(SpectralMhb::new(parse(SPECTRAL_MHB, p)?)?)),
         iterative: false,
         seconds_per_kilovertex: 0.039,
+        bytes_per_vertex: 3_100, // 3.04 GB at 1M (14.4 GiB at 2.1M before 793b558)
         table1: None,
     },
     MethodEntry {
@@ -85,6 +96,7 @@ pub const METHODS: &[MethodEntry] = &[
         create: |p| Ok(Box::new(ScaleAware::new(SCALE_AWARE, parse(SCALE_AWARE, p)?)?)),
         iterative: true,
         seconds_per_kilovertex: 0.48,
+        bytes_per_vertex: 11_100, // 1.38 GiB at 134K
         table1: None,
     },
     MethodEntry {
@@ -93,6 +105,7 @@ pub const METHODS: &[MethodEntry] = &[
         create: |p| Ok(Box::new(ScaleAware::new(SCALE_AWARE_ORA, parse(SCALE_AWARE_ORA, p)?)?)),
         iterative: true,
         seconds_per_kilovertex: 0.44,
+        bytes_per_vertex: 11_100, // scale_aware's
         table1: None,
     },
     MethodEntry {
@@ -101,6 +114,7 @@ pub const METHODS: &[MethodEntry] = &[
         create: |p| Ok(Box::new(Isolines::new(ISOLINES, parse(ISOLINES, p)?)?)),
         iterative: true,
         seconds_per_kilovertex: 0.0042,
+        bytes_per_vertex: 2_000, // 3.85 GiB at 2.1M
         table1: Some(Table1Side::Rebuilt),
     },
     MethodEntry {
@@ -109,6 +123,7 @@ pub const METHODS: &[MethodEntry] = &[
         create: |p| Ok(Box::new(Isolines::new(ISOLINES_T1, parse(ISOLINES_T1, p)?)?)),
         iterative: true,
         seconds_per_kilovertex: 0.0081,
+        bytes_per_vertex: 2_000, // isolines'; not measured at 2.1M
         table1: None,
     },
 ];
@@ -142,9 +157,21 @@ pub fn create(name: &str, params: &toml::Table) -> Result<Box<dyn DeformationMet
 }
 
 fn parse<P: DeserializeOwned>(method: &'static str, table: &toml::Table) -> Result<P, MethodError> {
-    toml::Value::Table(table.clone())
-        .try_into()
-        .map_err(|e: toml::de::Error| MethodError::Parameters { method, message: e.message().to_string() })
+    toml::Value::Table(table.clone()).try_into().map_err(|e: toml::de::Error| {
+        // The message of a value of the wrong type does not say whose it is: name the keys that
+        // fail on their own, with their values.
+        let alone = |key: &String, value: &toml::Value| {
+            let one = toml::Table::from_iter([(key.clone(), value.clone())]);
+            toml::Value::Table(one).try_into::<P>().is_err()
+        };
+        let faulty: Vec<String> =
+            table.iter().filter(|(k, v)| alone(k, v)).map(|(k, v)| format!("{k} = {v}")).collect();
+        let message = match faulty.is_empty() {
+            true => e.message().to_string(),
+            false => format!("{}: {}", faulty.join(", "), e.message()),
+        };
+        MethodError::Parameters { method, message }
+    })
 }
 
 #[cfg(test)]
@@ -155,6 +182,12 @@ mod tests {
     fn every_entry_describes_itself_for_the_harness() {
         for m in METHODS {
             assert!(m.seconds_per_kilovertex.is_finite() && m.seconds_per_kilovertex > 0.0, "{}", m.name);
+            assert!(
+                (100..100_000).contains(&m.bytes_per_vertex),
+                "{}: {} bytes per vertex",
+                m.name,
+                m.bytes_per_vertex
+            );
         }
         for side in [Table1Side::HandleIndependent, Table1Side::Rebuilt] {
             let sides = METHODS.iter().filter(|m| m.table1 == Some(side)).count();

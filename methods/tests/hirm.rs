@@ -187,7 +187,7 @@ fn bad_parameters_and_phases_are_errors() {
         HirmParams { omega: 0.0, ..HirmParams::default() },
     ];
     for params in bad {
-        assert!(matches!(Hirm::new(params), Err(MethodError::Parameters { .. })));
+        assert!(matches!(Hirm::new(params), Err(MethodError::InvalidParameters { .. })));
     }
     let (mesh, handles) = bar();
     let mut hirm = Hirm::new(HirmParams::default()).unwrap();

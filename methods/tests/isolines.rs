@@ -177,13 +177,16 @@ fn a_rigid_motion_of_all_handles_moves_the_mesh_rigidly() {
 
 #[test]
 fn bad_parameters_and_handle_sets_are_errors() {
-    for bad in [
-        IsolinesParams { isolines: 1, ..Default::default() },
-        IsolinesParams { max_crossed_triangles: 0, ..Default::default() },
-        IsolinesParams { omega: 0.0, ..Default::default() },
-        IsolinesParams { beta: f64::NAN, ..Default::default() },
+    for (bad, key) in [
+        (IsolinesParams { isolines: 1, ..Default::default() }, "isolines"),
+        (IsolinesParams { max_crossed_triangles: 0, ..Default::default() }, "max_crossed_triangles"),
+        (IsolinesParams { omega: 0.0, ..Default::default() }, "omega"),
+        (IsolinesParams { beta: f64::NAN, ..Default::default() }, "beta"),
     ] {
-        assert!(matches!(Isolines::new("isolines", bad), Err(MethodError::Parameters { .. })));
+        match Isolines::new("isolines", bad) {
+            Err(MethodError::InvalidParameters { faults, .. }) => assert_eq!(faults[0].keys(), [key]),
+            other => panic!("{key}: {:?}", other.err()),
+        }
     }
     let (mesh, handles) = bar(false);
     let mut m = method(IsolinesParams::default());

@@ -363,9 +363,9 @@ fn anderson_acceleration_finds_the_fixed_point_sooner() {
 #[test]
 fn bad_parameters_handle_sets_and_phase_order_are_errors() {
     let bad = ScaleAwareParams { constraint_weight: f64::NAN, ..Default::default() };
-    assert!(matches!(ScaleAware::new("scale_aware", bad), Err(MethodError::Parameters { .. })));
+    assert!(matches!(ScaleAware::new("scale_aware", bad), Err(MethodError::InvalidParameters { .. })));
     let bad = ScaleAwareParams { anderson_depth: 100, ..Default::default() };
-    assert!(matches!(ScaleAware::new("scale_aware", bad), Err(MethodError::Parameters { .. })));
+    assert!(matches!(ScaleAware::new("scale_aware", bad), Err(MethodError::InvalidParameters { .. })));
 
     let (mesh, handles) = cylinder();
     let mut m = ScaleAware::new("scale_aware", ScaleAwareParams::default()).unwrap();

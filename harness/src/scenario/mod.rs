@@ -359,6 +359,25 @@ fn skip_reason(error: &HarnessError) -> String {
     }
 }
 
+/// The size of mesh a scenario asks for, given to the run's memory check before the mesh is made,
+/// read or refined ([`ScenarioSpec::load_checked`]).
+pub struct SizeRequest<'a> {
+    pub spec: &'a ScenarioSpec,
+    /// The scenario's name (`<name>-<stem>` for a mesh of a collection).
+    pub scenario: &'a str,
+    /// The key of the scenario file that asks for the size: `refine = 12`,
+    /// `procedural = { shape = "bar", vertices = 5000000 }`, `mesh = "big.ply"`.
+    pub key: String,
+    /// The mesh, in words: `cube.off (8 vertices, 12 faces) refined 12 times: 100.7M vertices`.
+    pub mesh: String,
+    /// The mesh the methods will see.
+    pub vertices: f64,
+    pub faces: f64,
+}
+
+/// The run's memory check: `Err` refuses the size ([`crate::memory`]).
+pub type SizeCheck<'a> = &'a dyn Fn(&SizeRequest) -> Result<(), HarnessError>;
+
 /// A mesh file as read, and which of its vertices the scenario's mesh kept.
 #[derive(Clone, Debug)]
 pub struct InputMesh {
@@ -570,6 +589,13 @@ impl ScenarioSpec {
     /// no constrained vertex) is skipped with its reason; the others load. Errors: a single mesh
     /// that cannot be loaded, a collection that matches no file or whose every file is skipped.
     pub fn load(&self, source: &DataSource) -> Result<Loaded, HarnessError> {
+        self.load_checked(source, &|_| Ok(()))
+    }
+
+    /// [`ScenarioSpec::load`], each mesh's size given to `check` before the mesh is generated, read
+    /// (when its header tells its size: OFF, PLY) and refined, so a size the machine cannot hold is
+    /// refused before anything large is allocated.
+    pub fn load_checked(&self, source: &DataSource, check: SizeCheck) -> Result<Loaded, HarnessError> {
         let fail = |message: String| HarnessError::Scenario {
             scenario: self.name.clone(),
             file: Some(self.path.clone()),
@@ -594,10 +620,10 @@ impl ScenarioSpec {
         } else if let Some(mesh) = &self.mesh {
             let path = self.paths(None).resolve_existing("mesh", mesh).map_err(fail)?;
             let stem = file_stem(&path);
-            let scenario = self.load_file(&path, &self.name, Some(stem), None)?;
+            let scenario = self.load_file(&path, &self.name, Some(stem), None, check)?;
             return Ok(Loaded { scenarios: vec![scenario], skipped: Vec::new() });
         } else {
-            return Ok(Loaded { scenarios: vec![self.load_builtin(source)?], skipped: Vec::new() });
+            return Ok(Loaded { scenarios: vec![self.load_builtin(source, check)?], skipped: Vec::new() });
         };
         let mut loaded = Loaded { scenarios: Vec::new(), skipped: Vec::new() };
         for (path, attributes) in members {
@@ -606,7 +632,7 @@ impl ScenarioSpec {
             let name = format!("{}-{stem}", self.name);
             let member =
                 Member { collection: self.name.clone(), mesh: stem.clone(), attributes, repaired: None };
-            match self.load_file(&path, &name, Some(stem), Some(member.clone())) {
+            match self.load_file(&path, &name, Some(stem), Some(member.clone()), check) {
                 Ok(scenario) => loaded.scenarios.push(scenario),
                 Err(e) => loaded.skipped.push(SkippedInput {
                     scenario: name,
@@ -629,7 +655,7 @@ impl ScenarioSpec {
     }
 
     /// A survey mesh or procedural look-alike, with the survey edit or the scenario's regions.
-    fn load_builtin(&self, source: &DataSource) -> Result<LoadedScenario, HarnessError> {
+    fn load_builtin(&self, source: &DataSource, check: SizeCheck) -> Result<LoadedScenario, HarnessError> {
         let fail = |message: String| HarnessError::Scenario {
             scenario: self.name.clone(),
             file: Some(self.path.clone()),
@@ -642,6 +668,20 @@ impl ScenarioSpec {
         ) {
             (DataSource::Survey(dir), Some(stem), _) => {
                 let mesh_path = dir.join(format!("{stem}.off"));
+                if let Some((v, f)) = meshes::io::header_counts(&mesh_path) {
+                    check(&SizeRequest {
+                        spec: self,
+                        scenario: &self.name,
+                        key: format!("survey = \"{stem}\""),
+                        mesh: format!(
+                            "{} ({} vertices)",
+                            mesh_path.display(),
+                            crate::memory::count(v as f64)
+                        ),
+                        vertices: v as f64,
+                        faces: f as f64,
+                    })?;
+                }
                 for extension in ["off", "sel", "def"] {
                     self.files_read.push(dir.join(format!("{stem}.{extension}")));
                 }
@@ -656,6 +696,20 @@ impl ScenarioSpec {
             (_, _, Some(p)) => {
                 let kind: ShapeKind = p.shape.parse().map_err(|e| fail(format!("{e}")))?;
                 let target = p.vertices.unwrap_or_else(|| shapes::default_vertex_count(kind));
+                let vertices = p.vertices.map(|n| format!(", vertices = {n}")).unwrap_or_default();
+                check(&SizeRequest {
+                    spec: self,
+                    scenario: &self.name,
+                    key: format!("procedural = {{ shape = \"{}\"{vertices} }}", p.shape),
+                    mesh: format!(
+                        "the procedural {} of {} vertices",
+                        p.shape,
+                        crate::memory::count(target as f64)
+                    ),
+                    // A closed triangle mesh has about two faces per vertex.
+                    vertices: target as f64,
+                    faces: 2.0 * target as f64,
+                })?;
                 let shape = shapes::generate(kind, target)?;
                 shape.mesh.check_nondegenerate()?;
                 let topology = Topology::new(&shape.mesh)?;
@@ -708,12 +762,40 @@ impl ScenarioSpec {
         name: &str,
         stem: Option<String>,
         member: Option<Member>,
+        check: SizeCheck,
     ) -> Result<LoadedScenario, HarnessError> {
         let fail = |message: String| HarnessError::Scenario {
             scenario: name.to_string(),
             file: Some(self.path.clone()),
             message,
         };
+        // The size before anything is read when the header tells it, and before refining.
+        let request = |v: usize, f: usize, told: &str| {
+            let (vertices, faces) = crate::memory::refined_size(v as f64, f as f64, self.refine);
+            let (key, mesh) = if self.refine > 0 {
+                (
+                    format!("refine = {}", self.refine),
+                    format!(
+                        "{} ({v} vertices, {f} faces{told}) refined {} times: {} vertices, {} faces",
+                        path.display(),
+                        self.refine,
+                        crate::memory::count(vertices),
+                        crate::memory::count(faces)
+                    ),
+                )
+            } else {
+                let key = match (&self.mesh, &self.meshes) {
+                    (Some(m), _) => format!("mesh = \"{m}\""),
+                    (_, Some(g)) => format!("meshes = \"{g}\""),
+                    _ => "[manifest]".to_string(),
+                };
+                (key, format!("{} ({} vertices{told})", path.display(), crate::memory::count(vertices)))
+            };
+            SizeRequest { spec: self, scenario: name, key, mesh, vertices, faces }
+        };
+        if let Some((v, f)) = meshes::io::header_counts(path) {
+            check(&request(v, f, " by its header"))?;
+        }
         let mut input = meshes::io::read_mesh(path)?;
         let mut notes = Vec::new();
         let mut member = member;
@@ -730,6 +812,7 @@ impl ScenarioSpec {
             }
             input = repaired;
         }
+        check(&request(input.n_vertices(), input.n_faces(), ""))?;
         if self.refine > 0 {
             input = self.refined(input, path, &mut notes)?;
         }

@@ -107,6 +107,53 @@ pub fn read_mesh(path: impl AsRef<Path>) -> Result<TriMesh> {
     }
 }
 
+/// The vertex and face counts an OFF or PLY file's header announces, read from its first 64 KiB
+/// without reading the rest: what a caller can know of a mesh's size before loading it (the harness
+/// estimates a run's memory from it). `None` for other formats, an unreadable file or header, and
+/// counts the file is too small to hold (at least 3 bytes a vertex and 4 a face: a lying header is
+/// for the reader to report). A PLY face of more than 3 corners becomes several triangles, so the
+/// face count is a lower bound there.
+pub fn header_counts(path: impl AsRef<Path>) -> Option<(usize, usize)> {
+    use std::io::Read;
+    let path = path.as_ref();
+    let format = MeshFormat::from_path(path).ok()?;
+    if !matches!(format, MeshFormat::Off | MeshFormat::Ply) {
+        return None;
+    }
+    let file = File::open(path).ok()?;
+    let size = file.metadata().ok()?.len();
+    let mut head = Vec::new();
+    file.take(64 << 10).read_to_end(&mut head).ok()?;
+    let text = String::from_utf8_lossy(&head);
+    let counts = match format {
+        MeshFormat::Off => {
+            let mut lines = data_lines(&text).map(|(_, l)| l);
+            let mut tokens: Vec<&str> = lines.next()?.split_ascii_whitespace().collect();
+            if !tokens.first()?.ends_with("OFF") {
+                return None;
+            }
+            tokens.remove(0);
+            if tokens.is_empty() {
+                tokens = lines.next()?.split_ascii_whitespace().collect();
+            }
+            (tokens.first()?.parse().ok()?, tokens.get(1)?.parse().ok()?)
+        }
+        _ => {
+            let header = text.split("end_header").next()?;
+            let count = |element: &str| {
+                header.lines().find_map(|l| {
+                    let mut t = l.split_ascii_whitespace();
+                    (t.next() == Some("element") && t.next() == Some(element))
+                        .then(|| t.next()?.parse().ok())?
+                })
+            };
+            (count("vertex")?, count("face")?)
+        }
+    };
+    let needed = (counts.0 as u64).saturating_mul(3).saturating_add((counts.1 as u64).saturating_mul(4));
+    (needed <= size).then_some(counts)
+}
+
 /// Write `mesh` (`#V x 3` positions, `#F x 3` triangles) to `path`, choosing the writer from the
 /// extension: `.off`, `.obj`, `.ply` (binary, doubles) or `.glb` (without colors). Writing `.gltf` is not supported (a `.glb`
 /// holds the same content in one file). Atomic, see [`atomic_write`].
@@ -258,6 +305,28 @@ mod tests {
             assert_eq!(s.parse::<f64>().unwrap().to_bits(), x.to_bits(), "{x} printed as {s}");
             assert!(s.len() < 30, "{x} printed as {s}");
         }
+    }
+
+    #[test]
+    fn header_counts_are_read_from_off_and_ply_headers_alone() {
+        let dir = tempfile::tempdir().unwrap();
+        let off = dir.path().join("a.off");
+        fs::write(&off, "# a comment\nOFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n").unwrap();
+        assert_eq!(header_counts(&off), Some((4, 2)));
+        let ply = dir.path().join("a.ply");
+        let mesh = TriMesh::new(
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]],
+            vec![[0, 1, 2], [1, 3, 2]],
+        )
+        .unwrap();
+        write_ply(&ply, &mesh).unwrap();
+        assert_eq!(header_counts(&ply), Some((4, 2)));
+        let lying = dir.path().join("b.off");
+        fs::write(&lying, "OFF\n1000000000 1 0\n0 0 0\n").unwrap();
+        assert_eq!(header_counts(&lying), None, "counts the file cannot hold");
+        let obj = dir.path().join("a.obj");
+        write_obj(&obj, &mesh).unwrap();
+        assert_eq!(header_counts(&obj), None);
     }
 
     #[test]

@@ -66,6 +66,7 @@ use crate::method::{
     Phase, SolveSummary,
 };
 use crate::operators::{laplacian, LaplacianWeights};
+use crate::params::ParamCheck;
 use crate::rotation_fit::{closest_rotation_warm, Mat3};
 
 /// Parameters of [`Arap`] (configs/methods.toml, section `[arap]`).
@@ -114,6 +115,19 @@ pub enum ArapStart {
     Current,
     /// One global step with the handles' rotations propagated by harmonic weights.
     TransformationPropagation,
+}
+
+impl ArapParams {
+    /// Every key whose value breaks its rule, with that value ([`ParamCheck`]).
+    pub fn validate(&self) -> Result<(), MethodError> {
+        ParamCheck::new()
+            .count_at_least("max_iterations", self.max_iterations, 1)
+            .number_at_least("tolerance", self.tolerance, 0.0)
+            .count_at_most("anderson_depth", self.anderson_depth, crate::linalg::anderson::MAX_DEPTH)
+            .count_at_most("lbfgs_memory", self.lbfgs_memory, 64)
+            .number_in_half_open("lbfgs_scale_floor", self.lbfgs_scale_floor, 0.0, 1.0)
+            .finish(crate::keys::method_name::ARAP)
+    }
 }
 
 impl Default for ArapParams {
@@ -224,21 +238,7 @@ impl ArapEnergy {
 impl Arap {
     /// A method with the given parameters; call [`DeformationMethod::precompute`] next.
     pub fn new(params: ArapParams) -> Result<Self, MethodError> {
-        if params.max_iterations == 0
-            || !(params.tolerance >= 0.0)
-            || params.anderson_depth > crate::linalg::anderson::MAX_DEPTH
-            || params.lbfgs_memory > 64
-            || !(params.lbfgs_scale_floor > 0.0 && params.lbfgs_scale_floor <= 1.0)
-        {
-            return Err(MethodError::Parameters {
-                method: "arap",
-                message: format!(
-                    "max_iterations must be >= 1, tolerance >= 0, lbfgs_memory <= 64, lbfgs_scale_floor \
-                     in (0, 1] and anderson_depth <= {}",
-                    crate::linalg::anderson::MAX_DEPTH
-                ),
-            });
-        }
+        params.validate()?;
         Ok(Self {
             params,
             rest: Vec::new(),

@@ -109,6 +109,7 @@ use crate::method::{
     SolveSummary,
 };
 use crate::operators::{laplacian, lumped_mass_for, LaplacianWeights, MassKind};
+use crate::params::ParamCheck;
 
 /// Parameters of [`Hirm`] (configs/methods.toml, section `[hirm]`).
 #[derive(Clone, Debug, Deserialize)]
@@ -146,6 +147,24 @@ pub struct HirmParams {
     pub acceleration: Acceleration,
     /// Steps of history Anderson acceleration extrapolates from (at most 16).
     pub anderson_depth: usize,
+}
+
+impl HirmParams {
+    /// Every key whose value breaks its rule, with that value ([`ParamCheck`]).
+    pub fn validate(&self) -> Result<(), MethodError> {
+        ParamCheck::new()
+            .number_above("threshold", self.threshold, 1.0)
+            .count_at_least("max_fields", self.max_fields, 1)
+            .count_at_least("isolines", self.isolines, 2)
+            .count_at_least("max_crossed_triangles", self.max_crossed_triangles, 1)
+            .number_at_least("mu", self.mu, 0.0)
+            .number_above("omega", self.omega, 0.0)
+            .number_at_least("fields_per_region", self.fields_per_region, 0.0)
+            .count_at_least("max_iterations", self.max_iterations, 1)
+            .number_at_least("tolerance", self.tolerance, 0.0)
+            .count_at_most("anderson_depth", self.anderson_depth, MAX_DEPTH)
+            .finish(crate::keys::method_name::HIRM)
+    }
 }
 
 impl Default for HirmParams {
@@ -226,26 +245,7 @@ impl Drop for Hirm {
 impl Hirm {
     /// A method with the given parameters.
     pub fn new(params: HirmParams) -> Result<Self, MethodError> {
-        if !(params.threshold > 1.0)
-            || params.max_fields == 0
-            || params.isolines < 2
-            || params.max_crossed_triangles == 0
-            || !(params.mu >= 0.0)
-            || !(params.omega > 0.0)
-            || !(params.fields_per_region >= 0.0 && params.fields_per_region.is_finite())
-            || params.max_iterations == 0
-            || !(params.tolerance >= 0.0)
-            || params.anderson_depth > MAX_DEPTH
-        {
-            return Err(MethodError::Parameters {
-                method: "hirm",
-                message: format!(
-                    "threshold must be > 1, max_fields >= 1, isolines >= 2, max_crossed_triangles >= 1, \
-                     mu >= 0, omega > 0, fields_per_region >= 0 and finite, max_iterations >= 1, \
-                     tolerance >= 0, anderson_depth <= {MAX_DEPTH}"
-                ),
-            });
-        }
+        params.validate()?;
         Ok(Self {
             params,
             rest: None,

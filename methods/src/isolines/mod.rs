@@ -71,6 +71,7 @@ use crate::method::{
     SolveSummary,
 };
 use crate::operators::{laplacian, LaplacianWeights};
+use crate::params::ParamCheck;
 
 /// How the Laplacian coordinates of eq 1 are evaluated in the reduced iteration.
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
@@ -112,6 +113,22 @@ pub struct IsolinesParams {
     pub anderson_depth: usize,
     /// How `delta(X)` turns with the surface in the `vertices` variant ([`DeltaFrame`]).
     pub delta_frame: DeltaFrame,
+}
+
+impl IsolinesParams {
+    /// Every key whose value breaks its rule, with that value ([`ParamCheck`]), for the method
+    /// registered as `method`.
+    pub fn validate(&self, method: &'static str) -> Result<(), MethodError> {
+        ParamCheck::new()
+            .count_at_least("isolines", self.isolines, 2)
+            .count_at_least("max_crossed_triangles", self.max_crossed_triangles, 1)
+            .number_at_least("beta", self.beta, 0.0)
+            .number_above("omega", self.omega, 0.0)
+            .count_at_least("max_iterations", self.max_iterations, 1)
+            .number_at_least("tolerance", self.tolerance, 0.0)
+            .count_at_most("anderson_depth", self.anderson_depth, MAX_DEPTH)
+            .finish(method)
+    }
 }
 
 impl Default for IsolinesParams {
@@ -168,22 +185,7 @@ pub struct Isolines {
 impl Isolines {
     /// A method registered as `name` with the given parameters.
     pub fn new(name: &'static str, params: IsolinesParams) -> Result<Self, MethodError> {
-        if params.isolines < 2
-            || params.max_crossed_triangles == 0
-            || !(params.beta >= 0.0)
-            || !(params.omega > 0.0)
-            || params.max_iterations == 0
-            || !(params.tolerance >= 0.0)
-            || params.anderson_depth > MAX_DEPTH
-        {
-            return Err(MethodError::Parameters {
-                method: name,
-                message: format!(
-                    "isolines must be >= 2, max_crossed_triangles >= 1, beta >= 0, omega > 0, \
-                     max_iterations >= 1, tolerance >= 0, anderson_depth <= {MAX_DEPTH}"
-                ),
-            });
-        }
+        params.validate(name)?;
         Ok(Self {
             name,
             params,

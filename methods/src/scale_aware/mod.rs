@@ -96,6 +96,7 @@ use crate::method::{
     IterationObserver, IterationReport, Iterations, NoObserver, Phase, ReusedSolve, SolveSummary,
 };
 use crate::operators::LaplacianWeights;
+use crate::params::ParamCheck;
 use crate::rotation_fit::Mat3;
 use solve_memo::{Fingerprint, FingerprintBuilder, MemoizedSolve, RecordingObserver};
 
@@ -141,6 +142,23 @@ pub struct ScaleAwareParams {
     pub refactor_turn: f64,
     /// Apply the optimal rigidity approximation (section 5.3) to the converged result.
     pub optimal_rigidity: bool,
+}
+
+impl ScaleAwareParams {
+    /// Every key whose value breaks its rule, with that value ([`ParamCheck`]), for the method
+    /// registered as `method`.
+    pub fn validate(&self, method: &'static str) -> Result<(), MethodError> {
+        ParamCheck::new()
+            .number_above("constraint_weight", self.constraint_weight, 0.0)
+            .count_at_least("max_iterations", self.max_iterations, 1)
+            .number_at_least("tolerance", self.tolerance, 0.0)
+            .count_at_least("normal_sweeps", self.normal_sweeps, 1)
+            .number_at_least("normal_tolerance", self.normal_tolerance, 0.0)
+            .number_above("initialization_omega", self.initialization_omega, 0.0)
+            .count_at_most("anderson_depth", self.anderson_depth, anderson::MAX_DEPTH)
+            .number_at_least("refactor_turn", self.refactor_turn, 0.0)
+            .finish(method)
+    }
 }
 
 impl Default for ScaleAwareParams {
@@ -244,25 +262,9 @@ impl ScaleAware {
     /// A method registered as `name` with the given parameters; call
     /// [`DeformationMethod::precompute`] next.
     pub fn new(name: &'static str, params: ScaleAwareParams) -> Result<Self, MethodError> {
-        let valid = params.constraint_weight > 0.0
-            && params.constraint_weight.is_finite()
-            && params.max_iterations >= 1
-            && params.tolerance >= 0.0
-            && params.normal_sweeps >= 1
-            && params.normal_tolerance >= 0.0
-            && params.initialization_omega > 0.0
-            && params.anderson_depth <= anderson::MAX_DEPTH
-            && params.refactor_turn >= 0.0;
-        if !valid {
-            return Err(MethodError::Parameters {
-                method: name,
-                message: format!(
-                    "constraint_weight and initialization_omega must be > 0, max_iterations and \
-                     normal_sweeps >= 1, tolerance, normal_tolerance and refactor_turn >= 0, anderson_depth <= {}",
-                    anderson::MAX_DEPTH
-                ),
-            });
-        }
+        // Before the initialization is built from `initialization_omega`, so a bad value is named
+        // by its own key.
+        params.validate(name)?;
         let initialization = LaplacianEditing::new(LaplacianParams {
             omega: params.initialization_omega,
             weights: params.weights,

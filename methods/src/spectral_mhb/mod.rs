@@ -57,6 +57,7 @@ use crate::method::{
     require_phase, DeformationMethod, IterationObserver, IterationReport, Phase, SolveSummary,
 };
 use crate::operators::{laplacian, lumped_mass_for, LaplacianWeights, MassKind};
+use crate::params::ParamCheck;
 
 /// How the handle constraints enter the reduced system.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
@@ -98,6 +99,22 @@ pub struct SpectralMhbParams {
     pub seed: u64,
     /// Weights of `L_s` and the matching masses (see the module documentation).
     pub weights: LaplacianWeights,
+}
+
+impl SpectralMhbParams {
+    /// Every key whose value breaks its rule, with that value ([`ParamCheck`]).
+    pub fn validate(&self) -> Result<(), MethodError> {
+        let (s, b) = (self.stretching, self.bending);
+        ParamCheck::new()
+            .count_at_least("bases", self.bases, 1)
+            .number_at_least("stretching", s, 0.0)
+            .number_at_least("bending", b, 0.0)
+            // Both 0 leave the reduced energy without a term (only when each is itself valid).
+            .joint_rule(&[("stretching", s), ("bending", b)], !(s == 0.0 && b == 0.0), "must not both be 0")
+            .number_above("constraint_weight", self.constraint_weight, 0.0)
+            .number_above("eigen_tolerance", self.eigen_tolerance, 0.0)
+            .finish(crate::keys::method_name::SPECTRAL_MHB)
+    }
 }
 
 impl Default for SpectralMhbParams {
@@ -155,16 +172,7 @@ pub struct SpectralMhb {
 impl SpectralMhb {
     /// A method with the given parameters; call [`DeformationMethod::precompute`] next.
     pub fn new(params: SpectralMhbParams) -> Result<Self, MethodError> {
-        let bad = |m: &str| Err(MethodError::Parameters { method: "spectral_mhb", message: m.into() });
-        if params.bases == 0 {
-            return bad("bases must be >= 1");
-        }
-        if !(params.stretching >= 0.0 && params.bending >= 0.0 && params.stretching + params.bending > 0.0) {
-            return bad("stretching and bending must be >= 0 and not both 0");
-        }
-        if !(params.constraint_weight > 0.0) || !(params.eigen_tolerance > 0.0) {
-            return bad("constraint_weight and eigen_tolerance must be > 0");
-        }
+        params.validate()?;
         Ok(Self {
             params,
             rest: Vec::new(),
