@@ -167,28 +167,22 @@ impl ArapCase {
 
     /// libigl's `arap_solve` after `iterations` iterations (igl_reference.py `arap`), `#V x 3`.
     fn libigl_arap(&self, python: &std::path::Path, iterations: usize) -> Vec<[f64; 3]> {
-        let out = self.work.path().join(format!("igl{iterations}.txt"));
-        igl_reference(
-            python,
-            &[
-                "arap",
-                self.mesh_path.to_str().unwrap(),
-                self.constraints.to_str().unwrap(),
-                &iterations.to_string(),
-                out.to_str().unwrap(),
-            ],
-        );
-        read_rows(&out).into_iter().map(|r| [r[0], r[1], r[2]]).collect()
+        self.reference_arap(python, "arap", iterations)
     }
 
     /// The same SPOKES iteration as libigl's in float64 numpy (igl_reference.py `arap_float64`),
     /// `#V x 3`.
     fn float64_arap(&self, python: &std::path::Path, iterations: usize) -> Vec<[f64; 3]> {
-        let out = self.work.path().join(format!("f64-{iterations}.txt"));
+        self.reference_arap(python, "arap_float64", iterations)
+    }
+
+    /// igl_reference.py's ARAP `command` on this case after `iterations` iterations, `#V x 3`.
+    fn reference_arap(&self, python: &std::path::Path, command: &str, iterations: usize) -> Vec<[f64; 3]> {
+        let out = self.work.path().join(format!("{command}-{iterations}.txt"));
         igl_reference(
             python,
             &[
-                "arap_float64",
+                command,
                 self.mesh_path.to_str().unwrap(),
                 self.constraints.to_str().unwrap(),
                 &iterations.to_string(),
