@@ -195,8 +195,9 @@ pub fn export_built_in(dir: &Path) -> Result<Vec<PathBuf>, HarnessError> {
                 .into(),
         });
     }
-    // Written to a sibling staging directory and moved in file by file only once all were written,
-    // so a failure (a full disk) leaves nothing half-written in `dir`.
+    // Written to a hidden staging directory inside `dir` and moved into place file by file only once
+    // all were written, so a failure (a full disk) leaves no half-written file; the staging
+    // directory is removed when it is dropped.
     std::fs::create_dir_all(dir).map_err(|e| HarnessError::Io { path: dir.to_path_buf(), error: e })?;
     let staging = tempfile::Builder::new()
         .prefix(".deformbench-export-")

@@ -129,7 +129,7 @@ pub fn header_counts(path: impl AsRef<Path>) -> Option<(usize, usize)> {
         MeshFormat::Off => {
             let mut lines = data_lines(&text).map(|(_, l)| l);
             let mut tokens: Vec<&str> = lines.next()?.split_ascii_whitespace().collect();
-            if !tokens.first()?.ends_with("OFF") {
+            if !off::is_off_keyword(tokens.first()?) {
                 return None;
             }
             tokens.remove(0);

@@ -138,7 +138,7 @@ fn write_off_to(w: &mut dyn Write, mesh: &TriMesh) -> Result<()> {
 
 /// `[ST][C][N]OFF`: prefixes that only add per-vertex columns after `x y z`, which the reader ignores.
 /// `4OFF` and `nOFF` change the dimension and are rejected.
-fn is_off_keyword(keyword: &str) -> bool {
+pub(super) fn is_off_keyword(keyword: &str) -> bool {
     let Some(prefix) = keyword.strip_suffix("OFF") else {
         return false;
     };
