@@ -248,12 +248,12 @@ impl MethodCatalog {
             ),
             Some(_) => return Err(config("`scenarios` must be a list of scenario names".into())),
         };
-        let peers = std::fs::read_to_string(path.with_file_name("peers.toml")).unwrap_or_default();
+        let peers = peer_names(&path.with_file_name("peers.toml"));
         for (name, table) in tables_in_file_order(&text, top).map_err(config)? {
             let Some(base) = table.get("method").and_then(toml::Value::as_str) else {
                 return Err(config(format!("[{name}]: a sweep names its base method: method = \"…\"")));
             };
-            if self.get(base).is_none() && peers.contains(&format!("[{base}]")) {
+            if self.get(base).is_none() && peers.iter().any(|p| p == base) {
                 // A peer's knob: swept when the run has the peers.
                 eprintln!("note: sweep [{name}] of the peer `{base}` not run (add --peers)");
                 continue;
@@ -418,6 +418,16 @@ fn read_tables(path: &Path) -> Result<Vec<(String, toml::Table)>, HarnessError> 
     let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
     let table: toml::Table = text.parse().map_err(|e: toml::de::Error| config(e.to_string()))?;
     tables_in_file_order(&text, table).map_err(config)
+}
+
+/// The method names of the peers' file `path` (its top-level tables); none when it is missing or
+/// not TOML (the peers' own loading reports that when they are asked for).
+pub fn peer_names(path: &Path) -> Vec<String> {
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|text| text.parse::<toml::Table>().ok())
+        .map(|table| table.into_iter().filter(|(_, v)| v.is_table()).map(|(k, _)| k).collect())
+        .unwrap_or_default()
 }
 
 /// The top-level tables of `table`, parsed from `text`, in file order.

@@ -239,8 +239,8 @@ fn prepare_within(options: &SuiteOptions, check_memory: bool) -> Result<Prepared
 /// needs `--peers`), or `None` when it is one.
 fn unknown_method(options: &SuiteOptions, catalog: &MethodCatalog, name: &str) -> Option<String> {
     let message = catalog.find(name).err()?;
-    let peers = options.configs_dir.join("peers.toml");
-    let is_peer = std::fs::read_to_string(&peers).is_ok_and(|t| t.contains(&format!("[{name}]")));
+    let is_peer =
+        crate::config::peer_names(&options.configs_dir.join("peers.toml")).iter().any(|p| p == name);
     let hint = if is_peer && options.peers.is_none() { " (a peer: add --peers)" } else { "" };
     Some(format!("{message}{hint}"))
 }
