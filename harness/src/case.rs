@@ -9,12 +9,14 @@ use crate::metrics::{
     angle_errors, asked_scale, asked_turn, largest_displacement, Bends, Evaluation, Quality, RestGeometry,
 };
 use crate::record::{
-    records_quality, CaseResult, IterationRecord, ReusedSolveRecord, Spread, StepRecord, TimingSpread,
+    records_quality, CaseResult, IterationRecord, MeasurementTime, ReusedSolveRecord, Spread, StepRecord,
+    TimingSpread,
 };
-use crate::scenario::LoadedScenario;
+use crate::scenario::{LoadedScenario, LoadedStep};
 use crate::step_trend::StepTrend;
 use crate::verdict::{Motion, Status, Unfinished, VerdictRules};
-use methods::{IterationObserver, IterationReport};
+use methods::drive::{drive, Drive, DrivenStep, EditStep};
+use methods::{HandleSet, HandleTargets, IterationObserver, IterationReport, NoObserver, Stopping};
 
 /// The reason a case of an iterative method that did not report its convergence is `suspect`.
 pub const CONVERGENCE_UNKNOWN: &str =
@@ -31,20 +33,6 @@ pub(crate) struct Timings {
     total_s: f64,
 }
 
-/// The seconds of every iteration of a repetition (which records nothing else).
-struct IterationClock(Vec<f64>);
-
-impl IterationObserver for IterationClock {
-    fn on_iteration(
-        &mut self,
-        r: &IterationReport,
-        _: Option<&dyn Fn() -> Vec<[f64; 3]>>,
-    ) -> ControlFlow<()> {
-        self.0.push(r.seconds);
-        ControlFlow::Continue(())
-    }
-}
-
 /// Median, min and max of `values` (not empty).
 fn median_spread(mut values: Vec<f64>) -> (f64, Spread) {
     values.sort_by(f64::total_cmp);
@@ -53,8 +41,19 @@ fn median_spread(mut values: Vec<f64>) -> (f64, Spread) {
     (median, Spread { min: values[0], max: values[n - 1] })
 }
 
+/// A scenario's edit step as [`methods::drive`] takes it.
+impl EditStep for LoadedStep {
+    fn handles(&self) -> &HandleSet {
+        &self.handles
+    }
+
+    fn targets(&self, current: &[[f64; 3]]) -> Result<HandleTargets, methods::MethodError> {
+        LoadedStep::targets(self, current)
+    }
+}
+
 /// One more repetition of `method` on `scenario` (a round of `--repeat`): a fresh instance through
-/// every edit step, observed only for its iteration times; its timings and final `#V x 3` positions.
+/// every edit step, observed only by the drive; its timings and final `#V x 3` positions.
 pub(crate) fn repetition(
     scenario: &LoadedScenario,
     method: &ConfiguredMethod,
@@ -62,44 +61,39 @@ pub(crate) fn repetition(
 ) -> Result<(Timings, Vec<[f64; 3]>), methods::MethodError> {
     let mut m = method.create(None, threads)?;
     let startup_s = m.startup_seconds().unwrap_or(f64::NAN);
-    let mut clock = IterationClock(Vec::new());
-    let start = Instant::now();
-    m.precompute(&scenario.mesh)?;
-    let precompute_s = start.elapsed().as_secs_f64();
-    let (mut first_bind_s, mut solve_s, mut reused_s) = (f64::NAN, 0.0, 0.0);
-    for step in &scenario.steps {
-        let targets = step.targets(&m.positions())?;
-        let t = Instant::now();
-        m.bind_handles(&step.handles)?;
-        if first_bind_s.is_nan() {
-            first_bind_s = t.elapsed().as_secs_f64();
-        }
-        let t = Instant::now();
-        m.solve(&targets, &mut clock)?;
-        solve_s += t.elapsed().as_secs_f64();
-        reused_s += m.reused_solve().map_or(0.0, |r| r.seconds);
+    let drive = drive(m.as_mut(), &scenario.mesh, &scenario.steps, &mut NoObserver);
+    if let Some(failure) = drive.failure {
+        return Err(failure.error);
     }
-    solve_s += reused_s;
-    let total_s = start.elapsed().as_secs_f64() + reused_s;
-    let median_iteration_ms = median_of_seconds_ms(clock.0);
-    Ok((
-        Timings { startup_s, precompute_s, bind_s: first_bind_s, median_iteration_ms, solve_s, total_s },
-        m.positions(),
-    ))
+    let seconds = drive.steps.iter().flat_map(|s| &s.iterations).map(|r| r.seconds).collect();
+    let timings = Timings {
+        startup_s,
+        precompute_s: drive.precompute_s,
+        bind_s: drive.steps.first().map_or(f64::NAN, |s| s.bind_s),
+        median_iteration_ms: median_of_seconds_ms(seconds),
+        solve_s: drive.steps.iter().map(|s| s.solve_s).sum(),
+        total_s: drive.total_s,
+    };
+    Ok((timings, drive.positions))
 }
 
 /// Records every iteration, with the angle errors of the iterate where [`records_quality`] says so.
+/// The drive excludes the time spent here from the solve times.
 struct Recorder<'a> {
     scenario: &'a LoadedScenario,
     rest: &'a RestGeometry,
     trace: Vec<IterationRecord>,
     /// 1-based edit step being solved.
     edit_step: usize,
-    /// Wall time spent evaluating the angle errors, excluded from the reported solve times.
+    /// Wall time spent evaluating the angle errors.
     quality_s: f64,
 }
 
 impl IterationObserver for Recorder<'_> {
+    fn on_edit_step(&mut self, step: usize) {
+        self.edit_step = step;
+    }
+
     fn on_iteration(
         &mut self,
         r: &IterationReport,
@@ -147,6 +141,23 @@ pub struct CaseSettings {
     pub measure_memory: bool,
 }
 
+/// What the method instance said of itself once started.
+struct Started {
+    startup_s: f64,
+    about: Option<String>,
+    stopping: Option<Stopping>,
+    weights: Option<methods::operators::LaplacianWeights>,
+}
+
+/// The measures of a finished drive and the reasons it is suspect.
+struct Judged {
+    quality: Quality,
+    largest_move_over_diag: f64,
+    largest_handle_move_over_diag: f64,
+    reasons: Vec<String>,
+    evaluation_s: f64,
+}
+
 /// Run `method` on `scenario` (a fresh instance; an external method's stderr goes to `stderr_log`),
 /// as `settings` say, measure the result against `rest` (the scenario's rest geometry) and
 /// `reference`, and judge it by `rules`. A method error becomes a `failed` result; it does not abort
@@ -160,156 +171,227 @@ pub fn run_case(
     rules: &VerdictRules,
     reference: Reference<'_>,
 ) -> CaseResult {
-    let CaseSettings { threads, measure_memory } = settings;
-    let params = &method.params;
-    let mut result = CaseResult::empty(
-        &scenario.spec.name,
-        &method.name,
-        &scenario.mesh_source,
-        scenario.mesh.n_vertices(),
-        scenario.mesh.n_faces(),
-    );
-    result.origin = method.origin;
-    result.member = scenario.member.clone();
-    result.series = scenario.spec.series.clone();
-    result.sweeps = method.sweeps.clone();
-    result.laplacian_weights = match method.origin {
-        Origin::BuiltIn => laplacian_weights(params),
-        Origin::External | Origin::Peer => String::new(),
+    let memory = (settings.measure_memory && method.origin == Origin::BuiltIn)
+        .then(crate::memory::start_peak)
+        .flatten();
+    let mut instance = match method.create(stderr_log, settings.threads) {
+        Ok(m) => m,
+        Err(e) => {
+            return CaseRecord { scenario, method, started: None, drive: None, trace: Vec::new() }.failed(e)
+        }
+    };
+    let started = Started {
+        startup_s: instance.startup_seconds().unwrap_or(f64::NAN),
+        about: instance.about(),
+        stopping: instance.stopping(),
+        weights: instance.laplacian_weights(),
     };
     let mut recorder = Recorder { scenario, rest, trace: Vec::new(), edit_step: 0, quality_s: 0.0 };
-    let mut unfinished = Vec::new();
-    let cap = params.get("max_iterations").and_then(toml::Value::as_integer).map(|c| c as usize);
-    let tolerance = params.get("tolerance").and_then(toml::Value::as_float);
-    let outcome = (|| -> Result<Vec<String>, methods::MethodError> {
-        let memory =
-            (measure_memory && method.origin == Origin::BuiltIn).then(crate::memory::start_peak).flatten();
-        let mut m = method.create(stderr_log, threads)?;
-        result.startup_s = m.startup_seconds().unwrap_or(f64::NAN);
-        result.about = m.about();
-        let start = Instant::now();
-        m.precompute(&scenario.mesh)?;
-        result.precompute_s = start.elapsed().as_secs_f64();
-        let mut solve_s = 0.0;
-        let mut final_edit = None;
-        let mut largest_handle_move = 0.0f64;
-        for (i, step) in scenario.steps.iter().enumerate() {
-            let targets = step.targets(&m.positions())?;
-            for (v, t) in step.handles.constrained().zip(targets.positions()) {
-                let d = meshes::vector::norm(meshes::vector::sub(*t, scenario.mesh.positions()[v as usize]));
-                largest_handle_move = largest_handle_move.max(d);
-            }
-            let t = Instant::now();
-            m.bind_handles(&step.handles)?;
-            let bind_s = t.elapsed().as_secs_f64();
-            let first_iteration = recorder.trace.len();
-            recorder.edit_step = i + 1;
-            let quality_before = recorder.quality_s;
-            let t = Instant::now();
-            let summary = m.solve(&targets, &mut recorder)?;
-            let reused = m.reused_solve();
-            let reused_solve_s = reused.as_ref().map_or(0.0, |r| r.seconds);
-            let step_solve_s =
-                t.elapsed().as_secs_f64() - (recorder.quality_s - quality_before) + reused_solve_s;
-            solve_s += step_solve_s;
-            if let Some(r) = reused {
-                let record = result
-                    .reused_solve
-                    .get_or_insert(ReusedSolveRecord { from: r.from.to_string(), seconds: 0.0 });
-                record.seconds += r.seconds;
-            }
-            result.iterations += summary.iterations;
-            result.convergence_unknown |= summary.convergence_unknown;
-            if !summary.converged {
-                unfinished.push(Unfinished {
-                    step: i + 1,
-                    steps: scenario.steps.len(),
-                    iterations: summary.iterations,
-                    cap,
-                    last_step: summary.final_step,
-                    distance: summary.distance,
-                    tolerance,
-                    trend: tolerance.and_then(|t| {
-                        let steps: Vec<f64> =
-                            recorder.trace[first_iteration..].iter().map(|r| r.step).collect();
-                        StepTrend::of(&steps, t).map(|trend| trend.with_distance(summary.distance, t))
-                    }),
-                });
-            }
-            result.steps.push(StepRecord {
-                step: i + 1,
-                handles: step.handles.regions().len(),
-                constrained_vertices: step.handles.n_constrained(),
-                bind_s,
-                solve_s: step_solve_s,
-                iterations: summary.iterations,
-                converged: summary.converged,
-                final_step: summary.final_step,
-                fixed_point_distance: summary.distance,
-                median_iteration_ms: median_ms(&recorder.trace[first_iteration..]),
-                reused_solve_s,
-                phase_timings: m.phase_timings(),
-            });
-            final_edit = Some((step, targets));
-        }
-        result.converged = result.steps.iter().all(|s| s.converged);
-        result.fixed_point_distance = result.steps.iter().map(|s| s.fixed_point_distance).fold(0.0, nan_max);
-        let positions = m.positions();
-        result.bind_s = result.steps.first().map_or(f64::NAN, |s| s.bind_s);
-        result.solve_s = solve_s;
-        let reused_s = result.reused_solve.as_ref().map_or(0.0, |r| r.seconds);
-        result.total_s = start.elapsed().as_secs_f64() - recorder.quality_s + reused_s;
-        result.peak_memory_mib = crate::memory::peak_since(memory).unwrap_or(f64::NAN);
-        result.phase_timings = m.phase_timings();
-        result.statistics = m.model_statistics();
-        let (step, targets) = final_edit.expect("a scenario has at least one step");
-        if let Some(v) = positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-            return Err(methods::MethodError::NonFiniteResult { method: m.name().to_string(), vertex: v });
-        }
-        let evaluation_start = Instant::now();
-        let (reference, reference_finished) = match reference {
-            // Its own verdict does not wait for itself; its turn against itself is 0.
-            Reference::Itself => (Some(&positions[..]), true),
-            Reference::Of { positions, finished } => (Some(positions), finished),
-            Reference::Missing => (None, false),
-        };
-        result.quality = Quality::evaluate(&Evaluation::new(
-            rest,
-            &scenario.mesh,
-            &scenario.topology,
-            &positions,
-            (&step.handles, &targets),
-            reference,
-        ));
-        result.largest_move_over_diag =
-            largest_displacement(scenario.mesh.positions(), &positions) / rest.diagonal;
-        result.largest_handle_move_over_diag = largest_handle_move / rest.diagonal;
-        let motion = Motion {
-            largest_move: result.largest_move_over_diag,
-            largest_handle_move: result.largest_handle_move_over_diag,
-            asked_turn_deg: asked_turn(scenario.mesh.positions(), &step.handles, &targets, Bends::FromHeld)
-                .to_degrees(),
-            asked_scale: asked_scale(scenario.mesh.positions(), &step.handles, &targets),
-            reference_finished,
-        };
-        let mut reasons = rules.reasons(&result.quality, motion);
-        // A process that outlived its case is the case's to say (the token kill missed it).
-        reasons.extend(m.end());
-        if result.convergence_unknown {
-            reasons.push(CONVERGENCE_UNKNOWN.to_string());
-        }
-        result.positions = Some(positions);
-        result.overhead.evaluation_s = evaluation_start.elapsed().as_secs_f64();
-        Ok(reasons)
-    })();
-    result.median_iteration_ms = median_ms(&recorder.trace);
-    result.trace = recorder.trace;
-    result.overhead.trace_quality_s = recorder.quality_s;
-    result.status = match outcome {
-        Ok(reasons) => Status::judge(&unfinished, reasons),
-        Err(e) => Status::Failed(e.to_string()),
+    let drive = drive(instance.as_mut(), &scenario.mesh, &scenario.steps, &mut recorder);
+    let peak_memory_mib = crate::memory::peak_since(memory).unwrap_or(f64::NAN);
+    let trace_quality_s = recorder.quality_s;
+    let unfinished = unfinished_steps(&drive, started.stopping, scenario.steps.len());
+    let judged = match &drive.failure {
+        None => Ok(judge(scenario, rest, &drive, instance.as_mut(), rules, reference)),
+        Some(failure) => Err(failure.error.to_string()),
     };
-    result
+    let record =
+        CaseRecord { scenario, method, started: Some(started), drive: Some(&drive), trace: recorder.trace };
+    record.build(peak_memory_mib, trace_quality_s, judged, &unfinished)
+}
+
+/// The unfinished steps of `drive` (not converged), quoting the method's `stopping` rule.
+fn unfinished_steps(drive: &Drive, stopping: Option<Stopping>, steps: usize) -> Vec<Unfinished> {
+    let cap = stopping.and_then(|s| s.max_iterations);
+    let tolerance = stopping.and_then(|s| s.tolerance);
+    (1..)
+        .zip(&drive.steps)
+        .filter(|(_, s)| !s.summary.converged)
+        .map(|(step, s)| Unfinished {
+            step,
+            steps,
+            iterations: s.summary.iterations,
+            cap,
+            last_step: s.summary.final_step,
+            distance: s.summary.distance,
+            tolerance,
+            trend: tolerance.and_then(|t| {
+                let sizes: Vec<f64> = s.iterations.iter().map(|r| r.step).collect();
+                StepTrend::of(&sizes, t).map(|trend| trend.with_distance(s.summary.distance, t))
+            }),
+        })
+        .collect()
+}
+
+/// Measure the final shape of a finished `drive` and say why it is suspect, if it is: the rules'
+/// reasons, what the method could not end (`instance`'s [`methods::DeformationMethod::end`]) and an
+/// unknown convergence.
+fn judge(
+    scenario: &LoadedScenario,
+    rest: &RestGeometry,
+    drive: &Drive,
+    instance: &mut dyn methods::DeformationMethod,
+    rules: &VerdictRules,
+    reference: Reference<'_>,
+) -> Judged {
+    let start = Instant::now();
+    let positions = &drive.positions;
+    let last = drive.steps.last().expect("a scenario has at least one step");
+    let handles = &scenario.steps[drive.steps.len() - 1].handles;
+    let (reference, reference_finished) = match reference {
+        // Its own verdict does not wait for itself; its turn against itself is 0.
+        Reference::Itself => (Some(&positions[..]), true),
+        Reference::Of { positions, finished } => (Some(positions), finished),
+        Reference::Missing => (None, false),
+    };
+    let quality = Quality::evaluate(&Evaluation::new(
+        rest,
+        &scenario.mesh,
+        &scenario.topology,
+        positions,
+        (handles, &last.targets),
+        reference,
+    ));
+    let rest_positions = scenario.mesh.positions();
+    let largest_handle_move = (drive.steps.iter().zip(&scenario.steps))
+        .flat_map(|(driven, step)| step.handles.constrained().zip(driven.targets.positions()))
+        .map(|(v, t)| meshes::vector::norm(meshes::vector::sub(*t, rest_positions[v as usize])))
+        .fold(0.0f64, f64::max);
+    let motion = Motion {
+        largest_move: largest_displacement(rest_positions, positions) / rest.diagonal,
+        largest_handle_move: largest_handle_move / rest.diagonal,
+        asked_turn_deg: asked_turn(rest_positions, handles, &last.targets, Bends::FromHeld).to_degrees(),
+        asked_scale: asked_scale(rest_positions, handles, &last.targets),
+        reference_finished,
+    };
+    let mut reasons = rules.reasons(&quality, motion);
+    // A process that outlived its case is the case's to say (the token kill missed it).
+    reasons.extend(instance.end());
+    if drive.steps.iter().any(|s| s.summary.convergence_unknown) {
+        reasons.push(CONVERGENCE_UNKNOWN.to_string());
+    }
+    Judged {
+        quality,
+        largest_move_over_diag: motion.largest_move,
+        largest_handle_move_over_diag: motion.largest_handle_move,
+        reasons,
+        evaluation_s: start.elapsed().as_secs_f64(),
+    }
+}
+
+/// What a case's record is built from: who it is, what the instance said, the drive and its trace.
+struct CaseRecord<'a> {
+    scenario: &'a LoadedScenario,
+    method: &'a ConfiguredMethod,
+    started: Option<Started>,
+    drive: Option<&'a Drive>,
+    trace: Vec<IterationRecord>,
+}
+
+impl CaseRecord<'_> {
+    /// The record of a case whose method did not start.
+    fn failed(self, error: methods::MethodError) -> CaseResult {
+        self.build(f64::NAN, 0.0, Err(error.to_string()), &[])
+    }
+
+    /// The case's record: `judged` is the final shape's measures or the error that stopped the
+    /// case. The totals of a drive that ran every step are kept even when its result is refused
+    /// (non-finite), as the steps of a failed one are.
+    fn build(
+        self,
+        peak_memory_mib: f64,
+        trace_quality_s: f64,
+        judged: Result<Judged, String>,
+        unfinished: &[Unfinished],
+    ) -> CaseResult {
+        let (scenario, method) = (self.scenario, self.method);
+        let drive = self.drive;
+        let ran_every_step = drive.is_some_and(|d| d.steps.len() == scenario.steps.len());
+        let every_step = |value: f64| if ran_every_step { value } else { f64::NAN };
+        let steps: &[DrivenStep] = drive.map_or(&[], |d| &d.steps);
+        let started = self.started.as_ref();
+        let laplacian_weights = match method.origin {
+            Origin::BuiltIn => started.and_then(|s| s.weights).unwrap_or_default().name().to_string(),
+            Origin::External | Origin::Peer => String::new(),
+        };
+        let (status, judged) = match judged {
+            Ok(judged) => (Status::judge(unfinished, judged.reasons.clone()), Some(judged)),
+            Err(error) => (Status::Failed(error), None),
+        };
+        CaseResult {
+            scenario: scenario.spec.name.clone(),
+            method: method.name.clone(),
+            origin: method.origin,
+            about: started.and_then(|s| s.about.clone()),
+            mesh_source: scenario.mesh_source.clone(),
+            member: scenario.member.clone(),
+            series: scenario.spec.series.clone(),
+            vertices: scenario.mesh.n_vertices(),
+            faces: scenario.mesh.n_faces(),
+            laplacian_weights,
+            sweeps: method.sweeps.clone(),
+            startup_s: started.map_or(f64::NAN, |s| s.startup_s),
+            precompute_s: drive.map_or(f64::NAN, |d| d.precompute_s),
+            bind_s: every_step(steps.first().map_or(f64::NAN, |s| s.bind_s)),
+            median_iteration_ms: median_ms(&self.trace),
+            iterations: steps.iter().map(|s| s.summary.iterations).sum(),
+            solve_s: every_step(steps.iter().map(|s| s.solve_s).sum()),
+            total_s: every_step(drive.map_or(f64::NAN, |d| d.total_s)),
+            peak_memory_mib: every_step(peak_memory_mib),
+            converged: ran_every_step && steps.iter().all(|s| s.summary.converged),
+            fixed_point_distance: every_step(steps.iter().map(|s| s.summary.distance).fold(0.0, nan_max)),
+            convergence_unknown: steps.iter().any(|s| s.summary.convergence_unknown),
+            quality: judged.as_ref().map(|j| j.quality.clone()).unwrap_or_default(),
+            largest_move_over_diag: judged.as_ref().map_or(f64::NAN, |j| j.largest_move_over_diag),
+            largest_handle_move_over_diag: judged
+                .as_ref()
+                .map_or(f64::NAN, |j| j.largest_handle_move_over_diag),
+            self_intersecting: None,
+            status,
+            phase_timings: match (ran_every_step, steps.last()) {
+                (true, Some(last)) => last.phase_timings.clone(),
+                _ => Vec::new(),
+            },
+            statistics: drive.filter(|_| ran_every_step).map_or_else(Vec::new, |d| d.statistics.clone()),
+            reused_solve: reused_solve(steps),
+            steps: step_records(steps, scenario),
+            trace: self.trace,
+            overhead: MeasurementTime {
+                trace_quality_s,
+                evaluation_s: judged.as_ref().map_or(0.0, |j| j.evaluation_s),
+            },
+            spread: None,
+            positions: judged.is_some().then(|| drive.map(|d| d.positions.clone())).flatten(),
+        }
+    }
+}
+
+/// The solves `steps` took from another method's, summed, if any.
+fn reused_solve(steps: &[DrivenStep]) -> Option<ReusedSolveRecord> {
+    let from = steps.iter().find_map(|s| s.reused.as_ref())?.from.to_string();
+    let seconds = steps.iter().filter_map(|s| s.reused.as_ref()).map(|r| r.seconds).fold(0.0, |a, b| a + b);
+    Some(ReusedSolveRecord { from, seconds })
+}
+
+/// The records of the driven `steps` of `scenario`.
+fn step_records(steps: &[DrivenStep], scenario: &LoadedScenario) -> Vec<StepRecord> {
+    (1..)
+        .zip(steps.iter().zip(&scenario.steps))
+        .map(|(step, (driven, loaded))| StepRecord {
+            step,
+            handles: loaded.handles.regions().len(),
+            constrained_vertices: loaded.handles.n_constrained(),
+            bind_s: driven.bind_s,
+            solve_s: driven.solve_s,
+            iterations: driven.summary.iterations,
+            converged: driven.summary.converged,
+            final_step: driven.summary.final_step,
+            fixed_point_distance: driven.summary.distance,
+            median_iteration_ms: median_of_seconds_ms(driven.iterations.iter().map(|r| r.seconds).collect()),
+            reused_solve_s: driven.reused.as_ref().map_or(0.0, |r| r.seconds),
+            phase_timings: driven.phase_timings.clone(),
+        })
+        .collect()
 }
 
 /// The larger of `a` and `b`, NaN if either is (an unknown distance stays unknown).
@@ -381,14 +463,6 @@ pub(crate) fn add_repetitions(
         startup_s: startup,
     });
     result.status.add_reasons(reasons);
-}
-
-/// The `weights` of a method's parameter table, else the shared default (every method's).
-fn laplacian_weights(params: &toml::Table) -> String {
-    match params.get("weights").and_then(|v| v.as_str()) {
-        Some(name) => name.to_string(),
-        None => methods::operators::LaplacianWeights::default().name().to_string(),
-    }
 }
 
 /// Median iteration time in milliseconds (NaN for none).

@@ -5,11 +5,13 @@
 //! what is wrong in plain words (the harness's own reading of the answer: docs/protocol.md) or
 //! what came back, with the times. Exit 0 when the method speaks the protocol.
 
+use std::cell::RefCell;
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use meshes::shapes::{generate, ShapeKind};
+use meshes::shapes::{generate, ShapeKind, TestShape};
 use meshes::{TriMesh, VertexStatus};
+use methods::drive::{drive, Drive, DriveFailure, DrivePhase, DrivenStep, EditStep};
 use methods::{HandleRegion, HandleSet, HandleTargets, NoObserver};
 
 use crate::config::ConfiguredMethod;
@@ -38,13 +40,13 @@ pub fn check(method: &ConfiguredMethod) -> MethodCheck {
             return out;
         }
     };
-    let mesh = &shape.mesh;
-    let of = |status: VertexStatus| -> Vec<u32> {
-        (0..mesh.n_vertices() as u32).filter(|&v| shape.selection[v as usize] == status).collect()
+    let steps = match check_steps(&shape) {
+        Ok(steps) => steps,
+        Err(line) => {
+            out.lines.push(line);
+            return out;
+        }
     };
-    let (fixed, handle) = (of(VertexStatus::Fixed), of(VertexStatus::Handle));
-    let diagonal = mesh.bbox_diagonal();
-
     let started = Instant::now();
     let mut m = match method.create(None, 1) {
         Ok(m) => m,
@@ -55,101 +57,125 @@ pub fn check(method: &ConfiguredMethod) -> MethodCheck {
     };
     let about = m.about().map_or(String::new(), |a| format!(" (about: {a})"));
     out.lines.push(format!("ok    start and hello: {}{about}", seconds(started.elapsed().as_secs_f64())));
-
-    let t = Instant::now();
-    if let Err(e) = m.precompute(mesh) {
-        out.lines.push(format!(
-            "FAIL  precompute ({} vertices, {} faces): {e}",
-            mesh.n_vertices(),
-            mesh.n_faces()
-        ));
+    let drive = drive(m.as_mut(), &shape.mesh, &steps, &mut NoObserver);
+    out.lines.extend(drive_lines(&shape.mesh, &steps, &drive));
+    if drive.failure.is_some() {
         return out;
-    }
-    out.lines.push(format!(
-        "ok    precompute ({} vertices, {} faces): {}",
-        mesh.n_vertices(),
-        mesh.n_faces(),
-        seconds(t.elapsed().as_secs_f64())
-    ));
-
-    // Step 1: the survey's twist of the bar's end. Step 2: also hold the free vertex nearest the
-    // middle where step 1 left it (a handle set changed mid-edit, as incremental editing does).
-    let middle = nearest_free(mesh, &shape.selection);
-    let steps: [(&str, Vec<HandleRegion>); 2] = [
-        ("first bind (2 regions) and solve", vec![region("fixed", &fixed), region("handle", &handle)]),
-        (
-            "second bind (3 regions) and solve",
-            vec![region("fixed", &fixed), region("handle", &handle), region("middle", &[middle])],
-        ),
-    ];
-    for (what, regions) in steps {
-        let current = m.positions();
-        let handles = match HandleSet::new(regions, mesh.n_vertices()) {
-            Ok(h) => h,
-            Err(e) => {
-                out.lines.push(format!("FAIL  {what}: the check's handles: {e}"));
-                return out;
-            }
-        };
-        let targets: Vec<[f64; 3]> = handles
-            .constrained()
-            .map(|v| {
-                let p = mesh.positions()[v as usize];
-                match shape.selection[v as usize] {
-                    VertexStatus::Handle => shape.transform.apply(p),
-                    VertexStatus::Fixed => p,
-                    _ => current.get(v as usize).copied().unwrap_or(p),
-                }
-            })
-            .collect();
-        let targets = match HandleTargets::new(&handles, targets) {
-            Ok(t) => t,
-            Err(e) => {
-                out.lines.push(format!("FAIL  {what}: the check's targets: {e}"));
-                return out;
-            }
-        };
-        let t = Instant::now();
-        if let Err(e) = m.bind_handles(&handles) {
-            out.lines.push(format!("FAIL  {what}: bind: {e}"));
-            return out;
-        }
-        let bind_s = t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let summary = match m.solve(&targets, &mut NoObserver) {
-            Ok(s) => s,
-            Err(e) => {
-                out.lines.push(format!("FAIL  {what}: solve: {e}"));
-                return out;
-            }
-        };
-        let solve_s = t.elapsed().as_secs_f64();
-        let positions = m.positions();
-        let residual = handles
-            .constrained()
-            .zip(targets.positions())
-            .map(|(v, t)| meshes::vector::norm(meshes::vector::sub(positions[v as usize], *t)))
-            .fold(0.0, f64::max)
-            / diagonal;
-        let mut line = format!("ok    {what}: bind {}, solve {}", seconds(bind_s), seconds(solve_s));
-        let _ = write!(line, "; {} iteration(s)", summary.iterations);
-        let _ = write!(
-            line,
-            "; converged: {}",
-            if summary.convergence_unknown {
-                "not said (an iterative entry: its cases are `suspect: convergence unknown`)".to_string()
-            } else {
-                summary.converged.to_string()
-            }
-        );
-        let _ = write!(line, "; handles off their targets by {residual:.1e} of the diagonal");
-        out.lines.push(line);
     }
     let t = Instant::now();
     drop(m);
     out.lines.push(format!("ok    quit: {}", seconds(t.elapsed().as_secs_f64())));
     out.passed = true;
     out
+}
+
+/// A step of the check: what it is called, its handle set, the tiny bar's shape (for the targets)
+/// and the positions it started from (the previous step's answer: its handle residual).
+struct CheckStep<'a> {
+    what: &'static str,
+    handles: HandleSet,
+    shape: &'a TestShape,
+    started_from: RefCell<Vec<[f64; 3]>>,
+}
+
+impl EditStep for CheckStep<'_> {
+    fn handles(&self) -> &HandleSet {
+        &self.handles
+    }
+
+    /// The handle's twisted end, the fixed end at rest, any other region held where it is.
+    fn targets(&self, current: &[[f64; 3]]) -> Result<HandleTargets, methods::MethodError> {
+        *self.started_from.borrow_mut() = current.to_vec();
+        let mesh = &self.shape.mesh;
+        let targets: Vec<[f64; 3]> = (self.handles.constrained())
+            .map(|v| {
+                let p = mesh.positions()[v as usize];
+                match self.shape.selection[v as usize] {
+                    VertexStatus::Handle => self.shape.transform.apply(p),
+                    VertexStatus::Fixed => p,
+                    _ => current.get(v as usize).copied().unwrap_or(p),
+                }
+            })
+            .collect();
+        HandleTargets::new(&self.handles, targets)
+    }
+}
+
+/// Step 1: the survey's twist of the bar's end. Step 2: also hold the free vertex nearest the
+/// middle where step 1 left it (a handle set changed mid-edit, as incremental editing does). Or
+/// the line saying why the check's own handles are wrong.
+fn check_steps(shape: &TestShape) -> Result<[CheckStep<'_>; 2], String> {
+    let mesh = &shape.mesh;
+    let of = |status: VertexStatus| -> Vec<u32> {
+        (0..mesh.n_vertices() as u32).filter(|&v| shape.selection[v as usize] == status).collect()
+    };
+    let (fixed, handle) = (of(VertexStatus::Fixed), of(VertexStatus::Handle));
+    let middle = nearest_free(mesh, &shape.selection);
+    let step =
+        |what: &'static str, regions: Vec<HandleRegion>| match HandleSet::new(regions, mesh.n_vertices()) {
+            Ok(handles) => Ok(CheckStep { what, handles, shape, started_from: RefCell::new(Vec::new()) }),
+            Err(e) => Err(format!("FAIL  {what}: the check's handles: {e}")),
+        };
+    Ok([
+        step("first bind (2 regions) and solve", vec![region("fixed", &fixed), region("handle", &handle)])?,
+        step(
+            "second bind (3 regions) and solve",
+            vec![region("fixed", &fixed), region("handle", &handle), region("middle", &[middle])],
+        )?,
+    ])
+}
+
+/// The check's lines for `drive`: its precompute, each step that completed and what failed.
+fn drive_lines(mesh: &TriMesh, steps: &[CheckStep<'_>], drive: &Drive) -> Vec<String> {
+    let size = format!("{} vertices, {} faces", mesh.n_vertices(), mesh.n_faces());
+    let mut lines = Vec::new();
+    if drive.precompute_s.is_finite() {
+        lines.push(format!("ok    precompute ({size}): {}", seconds(drive.precompute_s)));
+    }
+    for (k, driven) in drive.steps.iter().enumerate() {
+        // Where the step left the shape: where the next one started, or the drive's end.
+        let after = steps.get(k + 1).map_or_else(|| drive.positions.clone(), |s| s.started_from.take());
+        let residual =
+            max_displacement_of_handles(&steps[k].handles, &driven.targets, &after) / mesh.bbox_diagonal();
+        lines.push(step_line(steps[k].what, driven, residual));
+    }
+    if let Some(DriveFailure { phase, step, error }) = &drive.failure {
+        let what = step.map_or("", |s| steps[s - 1].what);
+        lines.push(match phase {
+            DrivePhase::Precompute => format!("FAIL  precompute ({size}): {error}"),
+            DrivePhase::Targets => format!("FAIL  {what}: the check's targets: {error}"),
+            DrivePhase::BindHandles => format!("FAIL  {what}: bind: {error}"),
+            DrivePhase::Solve => format!("FAIL  {what}: solve: {error}"),
+            DrivePhase::Result => format!("FAIL  the answer: {error}"),
+        });
+    }
+    lines
+}
+
+/// The largest distance of a constrained vertex of `positions` from its target.
+fn max_displacement_of_handles(handles: &HandleSet, targets: &HandleTargets, positions: &[[f64; 3]]) -> f64 {
+    (handles.constrained().zip(targets.positions()))
+        .map(|(v, t)| meshes::vector::norm(meshes::vector::sub(positions[v as usize], *t)))
+        .fold(0.0, f64::max)
+}
+
+/// `ok` and what step `what` did: its times, iterations, convergence and handle residual.
+fn step_line(what: &str, driven: &DrivenStep, residual: f64) -> String {
+    let summary = &driven.summary;
+    let mut line =
+        format!("ok    {what}: bind {}, solve {}", seconds(driven.bind_s), seconds(driven.solve_s));
+    let _ = write!(line, "; {} iteration(s)", summary.iterations);
+    let _ = write!(
+        line,
+        "; converged: {}",
+        if summary.convergence_unknown {
+            "not said (an iterative entry: its cases are `suspect: convergence unknown`)".to_string()
+        } else {
+            summary.converged.to_string()
+        }
+    );
+    let _ = write!(line, "; handles off their targets by {residual:.1e} of the diagonal");
+    line
 }
 
 fn region(name: &str, vertices: &[u32]) -> HandleRegion {

@@ -151,6 +151,17 @@ impl DeformationMethod for LaplacianEditing {
         "laplacian"
     }
 
+    fn stopping(&self) -> Option<crate::method::Stopping> {
+        Some(crate::method::Stopping {
+            max_iterations: Some(self.params.max_iterations),
+            tolerance: Some(self.params.tolerance),
+        })
+    }
+
+    fn laplacian_weights(&self) -> Option<crate::operators::LaplacianWeights> {
+        Some(self.params.weights)
+    }
+
     fn precompute(&mut self, rest_mesh: &TriMesh) -> Result<(), MethodError> {
         let topology = Topology::new(rest_mesh)?;
         let positions = rest_mesh.positions();

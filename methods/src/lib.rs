@@ -2,6 +2,7 @@
 //! operators and solvers they share, and one module per method.
 
 pub mod arap;
+pub mod drive;
 pub mod error;
 pub mod external;
 pub mod handles;
@@ -24,5 +25,5 @@ pub use error::MethodError;
 pub use handles::{HandleRegion, HandleSet, HandleTargets};
 pub use method::{
     require_phase, DeformationMethod, DistanceBound, IterationObserver, IterationReport, NoObserver, Phase,
-    ReusedSolve, SolveSummary,
+    ReusedSolve, SolveSummary, Stopping,
 };

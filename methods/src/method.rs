@@ -21,6 +21,10 @@ pub struct IterationReport {
 
 /// Receives per-iteration reports; may ask for the current shape or stop the solve.
 pub trait IterationObserver {
+    /// Called by [`crate::drive::drive`] before the solve of edit step `step` (1-based), so that
+    /// the iterations that follow can be told apart by step.
+    fn on_edit_step(&mut self, _step: usize) {}
+
     /// Called after every iteration. `shape` computes the current `#V x 3` positions on demand
     /// (reduced models reconstruct them, so call it only when needed); `None` where the iterate is
     /// out of reach (an external method reports its iterations after its solve).
@@ -64,6 +68,16 @@ pub struct SolveSummary {
     pub convergence_unknown: bool,
 }
 
+/// How an iterative method stops: what a verdict on an unfinished solve quotes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stopping {
+    /// The most iterations of one solve (`max_iterations`), if the method has a cap.
+    pub max_iterations: Option<usize>,
+    /// The bound on the estimated distance to the fixed point over the rest bounding-box diagonal
+    /// ([`DistanceBound`]; `tolerance`), if the method has one.
+    pub tolerance: Option<f64>,
+}
+
 /// A solve's part that was reused, not computed ([`DeformationMethod::reused_solve`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReusedSolve {
@@ -98,6 +112,18 @@ pub trait DeformationMethod: Send {
 
     /// Current deformed positions, `#V x 3`.
     fn positions(&self) -> Vec<[f64; 3]>;
+
+    /// How its solve stops, from its parameters (their defaults included); `None` for a direct
+    /// method or one that does not say.
+    fn stopping(&self) -> Option<Stopping> {
+        None
+    }
+
+    /// The Laplacian weights it runs with (`weights`), for a method of this crate; `None` for one
+    /// that does not say (an external program).
+    fn laplacian_weights(&self) -> Option<crate::operators::LaplacianWeights> {
+        None
+    }
 
     /// Method-specific phase timings in seconds (e.g. HIRM's t_e, t_b), reported next to the common ones.
     fn phase_timings(&self) -> Vec<(String, f64)> {

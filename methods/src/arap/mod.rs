@@ -354,6 +354,17 @@ impl DeformationMethod for Arap {
         "arap"
     }
 
+    fn stopping(&self) -> Option<crate::method::Stopping> {
+        Some(crate::method::Stopping {
+            max_iterations: Some(self.params.max_iterations),
+            tolerance: Some(self.params.tolerance),
+        })
+    }
+
+    fn laplacian_weights(&self) -> Option<crate::operators::LaplacianWeights> {
+        Some(self.params.weights)
+    }
+
     fn precompute(&mut self, rest: &TriMesh) -> Result<(), MethodError> {
         meshes::Topology::new(rest)?;
         let laplacian = laplacian(self.params.weights, rest.positions(), rest.triangles())?;

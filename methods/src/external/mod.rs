@@ -191,6 +191,16 @@ impl DeformationMethod for ExternalMethod {
         &self.spec.name
     }
 
+    /// Its `max_iterations` (an integer) and `tolerance` (a float) parameters, where its entry
+    /// gives them: the program's own stopping rule is its business, these are only quoted.
+    fn stopping(&self) -> Option<crate::method::Stopping> {
+        let max_iterations =
+            self.spec.params.get("max_iterations").and_then(|v| v.as_u64()).map(|c| c as usize);
+        let tolerance = self.spec.params.get("tolerance").filter(|v| v.is_f64()).and_then(|v| v.as_f64());
+        (max_iterations.is_some() || tolerance.is_some())
+            .then_some(crate::method::Stopping { max_iterations, tolerance })
+    }
+
     fn precompute(&mut self, rest: &TriMesh) -> Result<(), MethodError> {
         self.call(
             "precompute",

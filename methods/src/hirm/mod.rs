@@ -346,6 +346,17 @@ impl DeformationMethod for Hirm {
         "hirm"
     }
 
+    fn stopping(&self) -> Option<crate::method::Stopping> {
+        Some(crate::method::Stopping {
+            max_iterations: Some(self.params.max_iterations),
+            tolerance: Some(self.params.tolerance),
+        })
+    }
+
+    fn laplacian_weights(&self) -> Option<crate::operators::LaplacianWeights> {
+        Some(self.params.weights)
+    }
+
     fn precompute(&mut self, rest: &TriMesh) -> Result<(), MethodError> {
         Topology::new(rest)?;
         self.timings.clear();

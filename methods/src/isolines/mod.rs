@@ -208,6 +208,17 @@ impl DeformationMethod for Isolines {
         self.name
     }
 
+    fn stopping(&self) -> Option<crate::method::Stopping> {
+        Some(crate::method::Stopping {
+            max_iterations: Some(self.params.max_iterations),
+            tolerance: Some(self.params.tolerance),
+        })
+    }
+
+    fn laplacian_weights(&self) -> Option<crate::operators::LaplacianWeights> {
+        Some(self.params.weights)
+    }
+
     fn precompute(&mut self, rest: &TriMesh) -> Result<(), MethodError> {
         let start = Instant::now();
         let topology = Topology::new(rest)?;

@@ -284,6 +284,10 @@ impl DeformationMethod for SpectralMhb {
         "spectral_mhb"
     }
 
+    fn laplacian_weights(&self) -> Option<crate::operators::LaplacianWeights> {
+        Some(self.params.weights)
+    }
+
     fn precompute(&mut self, rest: &TriMesh) -> Result<(), MethodError> {
         meshes::Topology::new(rest)?;
         let (p, tris) = (rest.positions(), rest.triangles());
