@@ -357,11 +357,23 @@ fn select_specs(options: &SuiteOptions) -> Result<Vec<ScenarioSpec>, HarnessErro
 /// The methods of each scenario the run covers, in catalog order: those its `methods` list names,
 /// else every method of the catalog that runs there (peers included when the run added them, sweep
 /// points on their sweep file's scenarios); `options.methods` applied.
-fn plan(options: &SuiteOptions, catalog: &MethodCatalog, scenarios: &[LoadedScenario]) -> Vec<Vec<String>> {
+fn plan(options: &SuiteOptions, catalog: &MethodCatalog, scenarios: &[LoadedScenario]) -> Vec<Vec<MethodId>> {
     scenarios
         .iter()
-        .map(|s| planned_methods(options, catalog, &s.spec, &s.spec.name).map(|m| m.name.clone()).collect())
+        .map(|s| planned_methods(options, catalog, &s.spec, &s.spec.name).map(|(id, _)| id).collect())
         .collect()
+}
+
+/// A method of the run's catalog: its index in [`MethodCatalog::methods`]. A plan holds these, so
+/// that nothing is looked up by name after planning.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct MethodId(usize);
+
+impl MethodId {
+    /// Its method in `catalog` (the catalog it was planned from).
+    fn of(self, catalog: &MethodCatalog) -> &ConfiguredMethod {
+        &catalog.methods()[self.0]
+    }
 }
 
 /// The methods [`plan`] gives the scenario `name` of `spec` (a collection's member has its own name).
@@ -370,16 +382,15 @@ fn planned_methods<'a>(
     catalog: &'a MethodCatalog,
     spec: &'a ScenarioSpec,
     name: &'a str,
-) -> impl Iterator<Item = &'a ConfiguredMethod> + 'a {
-    catalog
-        .methods()
-        .iter()
-        .filter(move |m| match &spec.methods {
+) -> impl Iterator<Item = (MethodId, &'a ConfiguredMethod)> + 'a {
+    (catalog.methods().iter().enumerate())
+        .filter(move |(_, m)| match &spec.methods {
             Some(list) => list.contains(&m.name),
             None => m.runs_on.as_ref().is_none_or(|on| on.iter().any(|s| s == name)),
         })
-        .filter(move |m| !spec.left_out.contains_key(&m.name) && m.unavailable.is_none())
-        .filter(move |m| options.methods.is_empty() || options.methods.iter().any(|x| *x == m.name))
+        .filter(move |(_, m)| !spec.left_out.contains_key(&m.name) && m.unavailable.is_none())
+        .filter(move |(_, m)| options.methods.is_empty() || options.methods.iter().any(|x| *x == m.name))
+        .map(|(i, m)| (MethodId(i), m))
 }
 
 /// Refuse the mesh size `request` when the scenario's estimated memory ([`crate::memory::estimate`]:
@@ -392,7 +403,7 @@ fn memory_check(
     request: &SizeRequest,
 ) -> Result<(), HarnessError> {
     let methods: Vec<(String, u64)> = planned_methods(options, catalog, request.spec, request.scenario)
-        .filter_map(|m| match &m.implementation {
+        .filter_map(|(_, m)| match &m.implementation {
             Implementation::BuiltIn(entry) => Some((m.name.clone(), entry.bytes_per_vertex)),
             Implementation::External(_) => None,
         })
@@ -432,10 +443,12 @@ pub fn run_shard(options: &SuiteOptions, shard: Shard) -> Result<SuiteRun, Harne
     let costs: Vec<f64> = scenarios
         .iter()
         .zip(&plan)
-        .map(|(s, m)| estimated_cost(s, &m.iter().map(String::as_str).collect::<Vec<_>>()))
+        .map(|(s, ids)| {
+            estimated_cost(s, &ids.iter().map(|id| id.of(&config.catalog).name.as_str()).collect::<Vec<_>>())
+        })
         .collect();
     let shard_of = assign(&costs, shard.count);
-    let (mine, plan): (Vec<(LoadedScenario, bool)>, Vec<Vec<String>>) = scenarios
+    let (mine, plan): (Vec<(LoadedScenario, bool)>, Vec<Vec<MethodId>>) = scenarios
         .into_iter()
         .zip(plan)
         .zip(&shard_of)
@@ -494,7 +507,7 @@ fn notes_of(options: &SuiteOptions, scenarios: &[LoadedScenario], skipped: &[Ski
     notes
 }
 
-/// Run `plan[i]` (method names) on `scenarios[i]` for every `i`, `options.jobs` cases at a time,
+/// Run `plan[i]` (methods of the catalog) on `scenarios[i]` for every `i`, `options.jobs` cases at a time,
 /// each job in its own pool of `options.threads` workers. Every scenario's [`REFERENCE_METHOD`] case
 /// is queued before the others, which wait for it (or run it) when they need its shape; results come
 /// back in plan order whatever the order they ran in, so a run's report does not depend on `jobs`.
@@ -508,14 +521,14 @@ fn run_plan(
     options: &SuiteOptions,
     config: &RunConfig,
     scenarios: &[LoadedScenario],
-    plan: &[Vec<String>],
+    plan: &[Vec<MethodId>],
 ) -> Result<Vec<CaseResult>, HarnessError> {
     let pools: Vec<rayon::ThreadPool> =
         (0..options.jobs.max(1)).map(|_| crate::threads::pool(options.threads)).collect::<Result<_, _>>()?;
-    let queue: Vec<(usize, &str)> = {
-        let planned =
-            || plan.iter().enumerate().flat_map(|(s, names)| names.iter().map(move |m| (s, m.as_str())));
-        let (references, others): (Vec<_>, Vec<_>) = planned().partition(|(_, m)| *m == REFERENCE_METHOD);
+    let is_reference = |id: &MethodId| id.of(&config.catalog).name == REFERENCE_METHOD;
+    let queue: Vec<(usize, MethodId)> = {
+        let planned = || plan.iter().enumerate().flat_map(|(s, ids)| ids.iter().map(move |id| (s, *id)));
+        let (references, others): (Vec<_>, Vec<_>) = planned().partition(|(_, id)| is_reference(id));
         references.into_iter().chain(others).collect()
     };
     let rounds = options.repetitions.max(1);
@@ -535,25 +548,26 @@ fn run_plan(
         scenarios,
         rests: scenarios.iter().map(|_| OnceLock::new()).collect(),
         references: scenarios.iter().map(|_| OnceLock::new()).collect(),
-        plans_reference: plan.iter().map(|names| names.iter().any(|m| m == REFERENCE_METHOD)).collect(),
+        reference_of: plan.iter().map(|ids| ids.iter().copied().find(is_reference)).collect(),
         bar: &bar,
     };
     let first = in_jobs(&pools, queue.len(), |i| {
         let (s, method) = queue[i];
-        let case = shared.run(s, method).map(|case| (s, case));
+        let case = shared.run(s, method).map(|case| (s, method, case));
         bar.inc(1);
         case
     });
-    let mut cases: Vec<(usize, CaseResult)> = first.into_iter().flatten().collect();
-    cases.extend(shared.references.into_iter().enumerate().filter_map(|(s, r)| Some((s, r.into_inner()?))));
-    cases.sort_by_key(|(s, c)| (*s, plan[*s].iter().position(|m| *m == c.method)));
+    let mut cases: Vec<(usize, MethodId, CaseResult)> = first.into_iter().flatten().collect();
+    let references = shared.references.into_iter().zip(&shared.reference_of).enumerate();
+    cases.extend(references.filter_map(|(s, (r, id))| Some((s, (*id)?, r.into_inner()?))));
+    cases.sort_by_key(|(s, id, _)| (*s, plan[*s].iter().position(|m| m == id)));
     if rounds > 1 {
         let mut later: Vec<Vec<_>> = cases.iter().map(|_| Vec::with_capacity(rounds - 1)).collect();
         for round in 2..=rounds {
             bar.set_message(format!("round {round} of {rounds}"));
             let timed = in_jobs(&pools, cases.len(), |i| {
-                let (s, case) = &cases[i];
-                let method = config.catalog.get(&case.method).expect("planned from the catalog");
+                let (s, id, case) = &cases[i];
+                let method = id.of(&config.catalog);
                 let again = (!case.status.is_failed())
                     .then(|| crate::case::repetition(&scenarios[*s], method, options.threads));
                 bar.inc(1);
@@ -563,13 +577,13 @@ fn run_plan(
                 later[i].extend(again);
             }
         }
-        for ((s, case), later) in cases.iter_mut().zip(later) {
+        for ((s, _, case), later) in cases.iter_mut().zip(later) {
             let diagonal = shared.rests[*s].get().map_or(f64::NAN, |r| r.diagonal);
             crate::case::add_repetitions(case, diagonal, later);
         }
     }
     bar.finish_and_clear();
-    Ok(cases.into_iter().map(|(_, case)| case).collect())
+    Ok(cases.into_iter().map(|(_, _, case)| case).collect())
 }
 
 /// `work(i)` for every `i < count`, `pools.len()` items at a time: one job thread per pool takes
@@ -613,33 +627,32 @@ struct SharedCases<'a> {
     scenarios: &'a [LoadedScenario],
     rests: Vec<OnceLock<RestGeometry>>,
     references: Vec<OnceLock<CaseResult>>,
-    /// Whether scenario `s` runs the reference at all.
-    plans_reference: Vec<bool>,
+    /// The reference method of scenario `s`'s plan, if it runs it.
+    reference_of: Vec<Option<MethodId>>,
     bar: &'a ProgressBar,
 }
 
 impl SharedCases<'_> {
     /// Run `method` on scenario `s`; `None` for the reference, which stays in `references`.
-    fn run(&self, s: usize, method: &str) -> Option<CaseResult> {
-        if method == REFERENCE_METHOD {
-            self.references[s].get_or_init(|| self.run_case(s, method, Reference::Itself));
+    fn run(&self, s: usize, method: MethodId) -> Option<CaseResult> {
+        let Some(reference) = self.reference_of[s] else {
+            return Some(self.run_case(s, method, Reference::Missing));
+        };
+        let r = self.references[s].get_or_init(|| self.run_case(s, reference, Reference::Itself));
+        if method == reference {
             return None;
         }
-        let reference = if self.plans_reference[s] {
-            let r = self.references[s].get_or_init(|| self.run_case(s, REFERENCE_METHOD, Reference::Itself));
-            let finished = r.status.is_ok() || r.status.is_suspect();
-            r.positions
-                .as_deref()
-                .map_or(Reference::Missing, |positions| Reference::Of { positions, finished })
-        } else {
-            Reference::Missing
-        };
+        let finished = r.status.is_ok() || r.status.is_suspect();
+        let reference = r
+            .positions
+            .as_deref()
+            .map_or(Reference::Missing, |positions| Reference::Of { positions, finished });
         Some(self.run_case(s, method, reference))
     }
 
-    fn run_case(&self, s: usize, method: &str, reference: Reference<'_>) -> CaseResult {
+    fn run_case(&self, s: usize, method: MethodId, reference: Reference<'_>) -> CaseResult {
         let scenario = &self.scenarios[s];
-        let method = self.config.catalog.get(method).expect("planned from the catalog");
+        let method = method.of(&self.config.catalog);
         self.bar.set_message(format!("{} / {}", scenario.spec.name, method.name));
         let rest = self.rests[s].get_or_init(|| RestGeometry::new(&scenario.mesh, &scenario.topology));
         let stderr_log = method.is_external().then(|| {
@@ -720,7 +733,9 @@ pub fn merge(options: &SuiteOptions, dirs: &[PathBuf]) -> Result<SuiteRun, Harne
                     case.scenario
                 )));
             };
-            let order = plan[i].iter().position(|m| *m == case.method).unwrap_or(usize::MAX);
+            let order = (plan[i].iter())
+                .position(|id| id.of(&config.catalog).name == case.method)
+                .unwrap_or(usize::MAX);
             if !case.status.is_failed() {
                 let mesh_path = dir.join("meshes").join(format!(
                     "{}.off",
