@@ -19,6 +19,67 @@ pub const PEER_OF_REFERENCE: &str = "libigl_arap";
 /// shape can be checked against ours like for like.
 pub const LIKE_FOR_LIKE_REFERENCE: &str = "arap_cotan";
 
+/// Which case a result is: its scenario and its method. A collection member's scenario is named
+/// `{collection}-{mesh}` ([`crate::scenario`]), so the scenario names the member too, and the
+/// committed baselines, which predate collections, key their cases by the same two names.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct CaseKey {
+    pub scenario: String,
+    pub method: String,
+}
+
+impl CaseKey {
+    pub fn new(scenario: &str, method: &str) -> Self {
+        CaseKey { scenario: scenario.to_string(), method: method.to_string() }
+    }
+
+    /// The case of `method` on the same scenario.
+    pub fn with_method(&self, method: &str) -> CaseKey {
+        CaseKey::new(&self.scenario, method)
+    }
+}
+
+/// A run's results with an index by [`CaseKey`]: the one way a report finds another case of the
+/// same scenario (the reference's, a peer's).
+pub struct CaseIndex<'a> {
+    results: &'a [CaseResult],
+    by_key: std::collections::HashMap<CaseKey, usize>,
+}
+
+impl<'a> CaseIndex<'a> {
+    /// The index of `results` (a key seen twice keeps its first case).
+    pub fn new(results: &'a [CaseResult]) -> Self {
+        let mut by_key = std::collections::HashMap::with_capacity(results.len());
+        for (i, r) in results.iter().enumerate() {
+            by_key.entry(r.key()).or_insert(i);
+        }
+        CaseIndex { results, by_key }
+    }
+
+    /// The case `key`, if the run has it.
+    pub fn get(&self, key: &CaseKey) -> Option<&'a CaseResult> {
+        self.by_key.get(key).map(|&i| &self.results[i])
+    }
+
+    /// The case of `method` on `case`'s scenario.
+    pub fn beside(&self, case: &CaseResult, method: &str) -> Option<&'a CaseResult> {
+        self.get(&case.key().with_method(method))
+    }
+
+    /// The reference method's case ([`REFERENCE_METHOD`]) on `case`'s scenario.
+    pub fn reference_of(&self, case: &CaseResult) -> Option<&'a CaseResult> {
+        self.beside(case, REFERENCE_METHOD)
+    }
+
+    /// The cases of scenario `scenario`, in run order.
+    pub fn of_scenario<'s>(&self, scenario: &'s str) -> impl Iterator<Item = &'a CaseResult> + 's
+    where
+        'a: 's,
+    {
+        self.results.iter().filter(move |r| r.scenario == scenario)
+    }
+}
+
 /// One iteration as recorded for convergence curves.
 #[derive(Clone, Copy, Debug, Serialize, Deserialize)]
 pub struct IterationRecord {
@@ -369,6 +430,11 @@ impl CaseResult {
             spread: None,
             positions: None,
         }
+    }
+
+    /// Which case it is.
+    pub fn key(&self) -> CaseKey {
+        CaseKey::new(&self.scenario, &self.method)
     }
 
     /// The value of `metric`, NaN where there is none.

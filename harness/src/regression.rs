@@ -7,7 +7,7 @@
 //! lacks. Improvements pass (and are listed, so the
 //! baseline can be renewed on purpose with `harness baseline`).
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::HarnessError;
 use crate::metrics::{Metric, METRICS};
-use crate::record::CaseResult;
+use crate::record::{CaseKey, CaseResult};
 use crate::verdict::STATUS_KINDS;
 
 /// One (scenario, method) of the baseline.
@@ -37,6 +37,20 @@ pub struct BaselineCase {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Baseline {
     pub cases: Vec<BaselineCase>,
+}
+
+impl BaselineCase {
+    /// Which case it is.
+    pub fn key(&self) -> CaseKey {
+        CaseKey::new(&self.scenario, &self.method)
+    }
+}
+
+impl Baseline {
+    /// Its cases by key.
+    fn index(&self) -> HashMap<CaseKey, &BaselineCase> {
+        self.cases.iter().map(|b| (b.key(), b)).collect()
+    }
 }
 
 /// Which committed baseline a run is compared with, by the data its meshes came from.
@@ -186,10 +200,11 @@ pub fn baseline_from(results: &[CaseResult]) -> Baseline {
 /// `mesh_source`), as `scenario / method (run's source, baseline's source)`; a comparison across
 /// data sources means nothing.
 pub fn foreign_cases(baseline: &Baseline, results: &[CaseResult]) -> Vec<String> {
+    let baseline = baseline.index();
     results
         .iter()
         .filter_map(|r| {
-            let b = baseline.cases.iter().find(|b| b.scenario == r.scenario && b.method == r.method)?;
+            let b = baseline.get(&r.key())?;
             (b.mesh_source != r.mesh_source).then(|| {
                 format!("{} / {} ({}, baseline: {})", r.scenario, r.method, r.mesh_source, b.mesh_source)
             })
@@ -202,13 +217,14 @@ pub fn foreign_cases(baseline: &Baseline, results: &[CaseResult]) -> Vec<String>
 /// its tolerance. In run order, then baseline order for the missing ones.
 pub fn check(baseline: &Baseline, results: &[CaseResult]) -> Vec<Finding> {
     let mut findings = Vec::new();
+    let index = baseline.index();
     for r in results {
         let (scenario, method) = (r.scenario.clone(), r.method.clone());
         if r.status.is_failed() {
             findings.push(Finding::Failed { scenario, method, status: r.status.to_string() });
             continue;
         }
-        let reference = baseline.cases.iter().find(|b| b.scenario == r.scenario && b.method == r.method);
+        let reference = index.get(&r.key()).copied();
         let rank = |kind: &str| STATUS_KINDS.iter().position(|k| *k == kind);
         if let Some((from, was, now)) =
             reference.and_then(|b| Some((b.verdict.clone(), rank(&b.verdict)?, rank(r.status.kind())?)))
@@ -242,8 +258,9 @@ pub fn check(baseline: &Baseline, results: &[CaseResult]) -> Vec<Finding> {
             }
         }
     }
+    let run: HashSet<CaseKey> = results.iter().map(CaseResult::key).collect();
     for b in &baseline.cases {
-        if !results.iter().any(|r| r.scenario == b.scenario && r.method == b.method) {
+        if !run.contains(&b.key()) {
             findings.push(Finding::Missing { scenario: b.scenario.clone(), method: b.method.clone() });
         }
     }
