@@ -403,41 +403,35 @@ fn nan_max(a: f64, b: f64) -> f64 {
     }
 }
 
-/// Fold the later repetitions of a case (rounds 2..N of `--repeat N`, from [`repetition`]) into
-/// `result`, its first: the timings become medians with their spread; a repetition whose result is
-/// not bitwise the first's, or that failed, makes the case `non-deterministic` (`diagonal`: the rest
-/// bounding-box diagonal, to say how far apart).
-pub(crate) fn add_repetitions(
-    result: &mut CaseResult,
+/// `first`, the first repetition's record of a case, with its later repetitions (rounds 2..N of
+/// `--repeat N`, from [`repetition`]) folded in: the timings become medians with their spread; a
+/// repetition whose result is not bitwise the first's, or that failed, makes the case
+/// `non-deterministic` (`diagonal`: the rest bounding-box diagonal, to say how far apart).
+pub(crate) fn with_repetitions(
+    first: CaseResult,
     diagonal: f64,
     later: Vec<Result<(Timings, Vec<[f64; 3]>), methods::MethodError>>,
-) {
-    let first = Timings {
-        startup_s: result.startup_s,
-        precompute_s: result.precompute_s,
-        bind_s: result.bind_s,
-        median_iteration_ms: result.median_iteration_ms,
-        solve_s: result.solve_s,
-        total_s: result.total_s,
-    };
-    let mut timings = vec![first];
+) -> CaseResult {
+    let mut timings = vec![Timings {
+        startup_s: first.startup_s,
+        precompute_s: first.precompute_s,
+        bind_s: first.bind_s,
+        median_iteration_ms: first.median_iteration_ms,
+        solve_s: first.solve_s,
+        total_s: first.total_s,
+    }];
     let mut reasons = Vec::new();
     for (k, again) in (2..).zip(later) {
         match again {
             Ok((t, positions)) => {
                 timings.push(t);
-                let reference = result.positions.as_deref().unwrap_or_default();
-                let same = positions.len() == reference.len()
-                    && positions
-                        .iter()
-                        .flatten()
-                        .zip(reference.iter().flatten())
-                        .all(|(a, b)| a.to_bits() == b.to_bits());
-                if !same && !reasons.iter().any(|r: &String| r.starts_with("non-deterministic")) {
-                    let apart = largest_displacement(reference, &positions) / diagonal;
-                    reasons.push(format!(
-                        "non-deterministic: repetition {k}'s result differs from the first (up to {apart:.1e} of the diagonal)"
-                    ));
+                let reference = first.positions.as_deref().unwrap_or_default();
+                if let Some(apart) = apart(reference, &positions, diagonal) {
+                    if !reasons.iter().any(|r: &String| r.starts_with("non-deterministic")) {
+                        reasons.push(format!(
+                            "non-deterministic: repetition {k}'s result differs from the first (up to {apart:.1e} of the diagonal)"
+                        ));
+                    }
                 }
             }
             Err(e) => reasons.push(format!("non-deterministic: repetition {k} failed: {e}")),
@@ -450,10 +444,7 @@ pub(crate) fn add_repetitions(
     let (total_s, total) = spread(|t| t.total_s);
     let (median_iteration_ms, iteration) = spread(|t| t.median_iteration_ms);
     let (startup_s, startup) = spread(|t| t.startup_s);
-    (result.precompute_s, result.bind_s, result.solve_s, result.total_s) =
-        (precompute_s, bind_s, solve_s, total_s);
-    (result.median_iteration_ms, result.startup_s) = (median_iteration_ms, startup_s);
-    result.spread = Some(TimingSpread {
+    let spread = TimingSpread {
         repetitions: timings.len(),
         precompute_s: precompute,
         bind_s: bind,
@@ -461,8 +452,27 @@ pub(crate) fn add_repetitions(
         total_s: total,
         median_iteration_ms: iteration,
         startup_s: startup,
-    });
-    result.status.add_reasons(reasons);
+    };
+    let mut status = first.status.clone();
+    status.add_reasons(reasons);
+    CaseResult {
+        precompute_s,
+        bind_s,
+        solve_s,
+        total_s,
+        median_iteration_ms,
+        startup_s,
+        spread: Some(spread),
+        status,
+        ..first
+    }
+}
+
+/// How far apart `a` and `b` are over `diagonal` when they are not bitwise equal (`None` if they are).
+fn apart(a: &[[f64; 3]], b: &[[f64; 3]], diagonal: f64) -> Option<f64> {
+    let same = a.len() == b.len()
+        && a.iter().flatten().zip(b.iter().flatten()).all(|(x, y)| x.to_bits() == y.to_bits());
+    (!same).then(|| largest_displacement(a, b) / diagonal)
 }
 
 /// Median iteration time in milliseconds (NaN for none).

@@ -577,10 +577,12 @@ fn run_plan(
                 later[i].extend(again);
             }
         }
-        for ((s, _, case), later) in cases.iter_mut().zip(later) {
-            let diagonal = shared.rests[*s].get().map_or(f64::NAN, |r| r.diagonal);
-            crate::case::add_repetitions(case, diagonal, later);
-        }
+        cases = (cases.into_iter().zip(later))
+            .map(|((s, id, first), later)| {
+                let diagonal = shared.rests[s].get().map_or(f64::NAN, |r| r.diagonal);
+                (s, id, crate::case::with_repetitions(first, diagonal, later))
+            })
+            .collect();
     }
     bar.finish_and_clear();
     Ok(cases.into_iter().map(|(_, _, case)| case).collect())
