@@ -391,24 +391,7 @@ where
     let cli = Cli::parse_from(args);
     match cli.command {
         Command::All { common, peers, meshes, gate, no_check, shard, force } => {
-            let mut options = common.options(Vec::new(), Vec::new(), &command_line)?;
-            options.force = force.force;
-            options.python = peers.python_path();
-            let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
-            options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
-            let (staging, staged_options) = staged(&options)?;
-            if let Some(shard) = shard {
-                return run_shard(&staged_options, staging, shard);
-            }
-            let gate = if no_check {
-                GateRequest::Skip("--no-check".to_string())
-            } else {
-                GateRequest::for_suite(&options, gate.baseline)
-            };
-            let publish = PublishOptions { peer_python: peers.python()?, meshes: meshes.output() };
-            let mut run = suite::run(&staged_options).context("preparing the run")?;
-            run.notes.extend(skipped_peers);
-            publish_and_print(&staged_options, staging, run, &publish, gate)
+            all(common, peers, meshes, gate, no_check, shard, force, &command_line)
         }
         Command::Merge { partials, common, meshes, gate, sweeps } => {
             let mut options = common.options(Vec::new(), Vec::new(), &command_line)?;
@@ -420,25 +403,7 @@ where
             publish_and_print(&staged_options, staging, run, &publish, gate)
         }
         Command::Run { methods, scenarios, common, peers, meshes, force } => {
-            let mut options = common.options(scenarios, methods, &command_line)?;
-            options.force = force.force;
-            if options.methods.is_empty() {
-                suite::require_listed_methods(&options)?;
-            }
-            options.python = peers.python_path();
-            let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
-            options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
-            let publish = PublishOptions { peer_python: peers.python()?, meshes: meshes.output() };
-            let (staging, staged_options) = staged(&options)?;
-            let mut run = suite::run(&staged_options).context("preparing the run")?;
-            run.notes.extend(skipped_peers);
-            publish_and_print(
-                &staged_options,
-                staging,
-                run,
-                &publish,
-                GateRequest::Skip("`run` covers chosen scenarios and methods".to_string()),
-            )
+            run_chosen(methods, scenarios, common, peers, meshes, force, &command_line)
         }
         Command::Check { common, gate } => {
             let dir = common.options(Vec::new(), Vec::new(), &command_line)?.reports_dir;
@@ -453,56 +418,8 @@ where
             println!("baseline: {cases} cases from {} written to {}", dir.display(), path.display());
             Ok(ExitCode::SUCCESS)
         }
-        Command::Compare { a, b, out, fail_on, min_change } => {
-            anyhow::ensure!(
-                (0.0..1.0).contains(&min_change),
-                "--min-change {min_change}: a fraction in [0, 1), e.g. 0.05 for 5%"
-            );
-            let (a, b) = (ComparedRun::read(&a)?, ComparedRun::read(&b)?);
-            let comparison = crate::comparison::compare(&a, &b, min_change);
-            let out = out.unwrap_or_else(|| crate::paths::current_dir_join("reports/comparison"));
-            crate::report::write_comparison(&out, &comparison)
-                .with_context(|| format!("writing the comparison to {}", out.display()))?;
-            // The warnings head the printed markdown.
-            println!("{}", crate::report::run_comparison::render_markdown(&comparison));
-            println!("comparison: {} (compare.md, compare.html)", out.display());
-            let tally = comparison.tally();
-            if fail_on.contains(&FailOn::Worse) && tally.worse > 0 {
-                eprintln!("error: {} case(s) worse in quality", tally.worse);
-                return Ok(ExitCode::from(EXIT_REGRESSION));
-            }
-            if fail_on.contains(&FailOn::Slower) && tally.slower > 0 {
-                eprintln!("error: {} case(s) slower", tally.slower);
-                return Ok(ExitCode::from(EXIT_SLOWER));
-            }
-            Ok(ExitCode::SUCCESS)
-        }
-        Command::CheckMethod { name, common, python } => {
-            let mut options = common.options(Vec::new(), Vec::new(), &command_line)?;
-            if python.is_some() {
-                options.python = python;
-            }
-            let catalog = suite::load_catalog(&options)?;
-            let method = catalog.find(&name).map_err(|m| anyhow::anyhow!("{m}"))?;
-            println!(
-                "checking `{name}` ({}) on a {}-vertex bar:",
-                method.summary,
-                crate::method_check::CHECK_VERTICES
-            );
-            let result = crate::method_check::check(method);
-            for line in &result.lines {
-                println!("  {line}");
-            }
-            if result.passed {
-                println!("`{name}` speaks the protocol");
-                Ok(ExitCode::SUCCESS)
-            } else {
-                println!(
-                    "`{name}` does not speak the protocol yet: see the FAIL line above and docs/protocol.md"
-                );
-                Ok(ExitCode::from(EXIT_CASE_FAILED))
-            }
-        }
+        Command::Compare { a, b, out, fail_on, min_change } => compare(&a, &b, out, &fail_on, min_change),
+        Command::CheckMethod { name, common, python } => check_method(&name, common, python, &command_line),
         Command::History { command } => history::run(command),
         Command::Configs { command: ConfigsCommand::Export { dir } } => {
             let written = crate::paths::export_built_in(&dir)?;
@@ -514,31 +431,160 @@ where
             );
             Ok(ExitCode::SUCCESS)
         }
-        Command::List(common) => {
-            let options = common.options(Vec::new(), Vec::new(), &command_line)?;
-            println!("methods ({}):", options.configs_dir.join("methods.toml").display());
-            let catalog = suite::load_catalog(&options)?;
-            let methods: Vec<Vec<String>> = catalog
-                .methods()
-                .iter()
-                .map(|m| {
-                    let what = match &m.unavailable {
-                        None => m.summary.clone(),
-                        Some(why) => format!("UNAVAILABLE: {why} ({})", m.file.display()),
-                    };
-                    vec![m.name.clone(), m.origin.label().to_string(), what]
-                })
-                .collect();
-            columns(&methods).iter().for_each(|line| println!("{line}"));
-            println!("scenarios ({}):", options.configs_dir.join("scenarios").display());
-            let scenarios: Vec<Vec<String>> = load_specs(&options.configs_dir.join("scenarios"))?
-                .into_iter()
-                .map(|s| vec![s.name, s.description])
-                .collect();
-            columns(&scenarios).iter().for_each(|line| println!("{line}"));
-            Ok(ExitCode::SUCCESS)
-        }
+        Command::List(common) => list(common, &command_line),
     }
+}
+
+/// `all`: every method on every scenario, published and gated (or one shard of it).
+#[allow(clippy::too_many_arguments)]
+fn all(
+    common: Common,
+    peers: Peers,
+    meshes: Meshes,
+    gate: Gate,
+    no_check: bool,
+    shard: Option<Shard>,
+    force: Force,
+    command_line: &[String],
+) -> anyhow::Result<ExitCode> {
+    let mut options = common.options(Vec::new(), Vec::new(), command_line)?;
+    options.force = force.force;
+    options.python = peers.python_path();
+    let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
+    options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
+    let (staging, staged_options) = staged(&options)?;
+    if let Some(shard) = shard {
+        return run_shard(&staged_options, staging, shard);
+    }
+    let gate = if no_check {
+        GateRequest::Skip("--no-check".to_string())
+    } else {
+        GateRequest::for_suite(&options, gate.baseline)
+    };
+    let publish = PublishOptions { peer_python: peers.python()?, meshes: meshes.output() };
+    let mut run = suite::run(&staged_options).context("preparing the run")?;
+    run.notes.extend(skipped_peers);
+    publish_and_print(&staged_options, staging, run, &publish, gate)
+}
+
+/// `run`: the chosen scenarios and methods, published without the gate.
+fn run_chosen(
+    methods: Vec<String>,
+    scenarios: Vec<String>,
+    common: Common,
+    peers: Peers,
+    meshes: Meshes,
+    force: Force,
+    command_line: &[String],
+) -> anyhow::Result<ExitCode> {
+    let mut options = common.options(scenarios, methods, command_line)?;
+    options.force = force.force;
+    if options.methods.is_empty() {
+        suite::require_listed_methods(&options)?;
+    }
+    options.python = peers.python_path();
+    let skipped_peers = options.add_peers(peers.peer_methods(&options.configs_dir));
+    options.sweeps = peers.sweeps.then(|| options.configs_dir.join("sweeps.toml"));
+    let publish = PublishOptions { peer_python: peers.python()?, meshes: meshes.output() };
+    let (staging, staged_options) = staged(&options)?;
+    let mut run = suite::run(&staged_options).context("preparing the run")?;
+    run.notes.extend(skipped_peers);
+    publish_and_print(
+        &staged_options,
+        staging,
+        run,
+        &publish,
+        GateRequest::Skip("`run` covers chosen scenarios and methods".to_string()),
+    )
+}
+
+/// `compare A B`: two runs side by side, written to `out`; the exit code `fail_on` asks for.
+fn compare(
+    a: &std::path::Path,
+    b: &std::path::Path,
+    out: Option<PathBuf>,
+    fail_on: &[FailOn],
+    min_change: f64,
+) -> anyhow::Result<ExitCode> {
+    anyhow::ensure!(
+        (0.0..1.0).contains(&min_change),
+        "--min-change {min_change}: a fraction in [0, 1), e.g. 0.05 for 5%"
+    );
+    let (a, b) = (ComparedRun::read(a)?, ComparedRun::read(b)?);
+    let comparison = crate::comparison::compare(&a, &b, min_change);
+    let out = out.unwrap_or_else(|| crate::paths::current_dir_join("reports/comparison"));
+    crate::report::write_comparison(&out, &comparison)
+        .with_context(|| format!("writing the comparison to {}", out.display()))?;
+    // The warnings head the printed markdown.
+    println!("{}", crate::report::run_comparison::render_markdown(&comparison));
+    println!("comparison: {} (compare.md, compare.html)", out.display());
+    let tally = comparison.tally();
+    if fail_on.contains(&FailOn::Worse) && tally.worse > 0 {
+        eprintln!("error: {} case(s) worse in quality", tally.worse);
+        return Ok(ExitCode::from(EXIT_REGRESSION));
+    }
+    if fail_on.contains(&FailOn::Slower) && tally.slower > 0 {
+        eprintln!("error: {} case(s) slower", tally.slower);
+        return Ok(ExitCode::from(EXIT_SLOWER));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `check-method NAME`: the protocol check of one method ([`crate::method_check`]).
+fn check_method(
+    name: &str,
+    common: Common,
+    python: Option<PathBuf>,
+    command_line: &[String],
+) -> anyhow::Result<ExitCode> {
+    let mut options = common.options(Vec::new(), Vec::new(), command_line)?;
+    if python.is_some() {
+        options.python = python;
+    }
+    let catalog = suite::load_catalog(&options)?;
+    let method = catalog.find(name).map_err(|m| anyhow::anyhow!("{m}"))?;
+    println!(
+        "checking `{name}` ({}) on a {}-vertex bar:",
+        method.summary,
+        crate::method_check::CHECK_VERTICES
+    );
+    let result = crate::method_check::check(method);
+    for line in &result.lines {
+        println!("  {line}");
+    }
+    if result.passed {
+        println!("`{name}` speaks the protocol");
+        Ok(ExitCode::SUCCESS)
+    } else {
+        println!("`{name}` does not speak the protocol yet: see the FAIL line above and docs/protocol.md");
+        Ok(ExitCode::from(EXIT_CASE_FAILED))
+    }
+}
+
+/// `list`: the configuration's methods and scenarios, in aligned columns.
+fn list(common: Common, command_line: &[String]) -> anyhow::Result<ExitCode> {
+    let options = common.options(Vec::new(), Vec::new(), command_line)?;
+    println!("methods ({}):", options.configs_dir.join("methods.toml").display());
+    let catalog = suite::load_catalog(&options)?;
+    let methods: Vec<Vec<String>> = catalog
+        .methods()
+        .iter()
+        .map(|m| {
+            let what = match &m.unavailable {
+                None => m.summary.clone(),
+                Some(why) => format!("UNAVAILABLE: {why} ({})", m.file.display()),
+            };
+            vec![m.name.clone(), m.origin.label().to_string(), what]
+        })
+        .collect();
+    columns(&methods).iter().for_each(|line| println!("{line}"));
+    println!("scenarios ({}):", options.configs_dir.join("scenarios").display());
+    let scenarios: Vec<Vec<String>> = load_specs(&options.configs_dir.join("scenarios"))?
+        .into_iter()
+        .map(|s| vec![s.name, s.description])
+        .collect();
+    columns(&scenarios).iter().for_each(|line| println!("{line}"));
+    Ok(ExitCode::SUCCESS)
 }
 
 /// `rows` as lines of aligned columns: indented by two, each column but the last as wide as its
