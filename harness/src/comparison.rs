@@ -10,12 +10,12 @@
 //! beyond the commit (machine, threads, jobs, repetitions, build profile, data, input files) is a
 //! warning, never silent.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use crate::error::HarnessError;
 use crate::provenance::Provenance;
-use crate::record::{CaseResult, TimedPhase};
+use crate::record::{CaseKey, CaseResult, TimedPhase};
 use crate::regression::{self, Finding};
 use crate::stored_report::{read_results, StoredReport};
 
@@ -239,13 +239,12 @@ impl Comparison {
 /// Compare run `b` with run `a` (the earlier one, or the reference).
 pub fn compare(a: &ComparedRun, b: &ComparedRun, min_change: f64) -> Comparison {
     let (ra, rb) = (&a.report, &b.report);
-    let key = |c: &CaseResult| (c.scenario.clone(), c.method.clone());
-    let a_cases: BTreeMap<(String, String), &CaseResult> = ra.cases.iter().map(|c| (key(c), c)).collect();
+    let a_cases: BTreeMap<CaseKey, &CaseResult> = ra.cases.iter().map(|c| (c.key(), c)).collect();
     let findings = regression::check(&regression::baseline_from(&ra.cases), &rb.cases);
     let mut cases = Vec::new();
     let mut only_in_b = Vec::new();
     for cb in &rb.cases {
-        let Some(ca) = a_cases.get(&key(cb)) else {
+        let Some(ca) = a_cases.get(&cb.key()) else {
             only_in_b.push(format!("{} / {}", cb.scenario, cb.method));
             continue;
         };
@@ -262,11 +261,8 @@ pub fn compare(a: &ComparedRun, b: &ComparedRun, min_change: f64) -> Comparison 
                 }
             })
             .collect();
-        let quality = findings
-            .iter()
-            .filter(|f| finding_case(f) == Some((&cb.scenario, &cb.method)))
-            .cloned()
-            .collect();
+        let quality =
+            findings.iter().filter(|f| finding_case(f).as_ref() == Some(&cb.key())).cloned().collect();
         cases.push(CaseChange {
             scenario: cb.scenario.clone(),
             method: cb.method.clone(),
@@ -276,11 +272,11 @@ pub fn compare(a: &ComparedRun, b: &ComparedRun, min_change: f64) -> Comparison 
             quality,
         });
     }
-    let b_keys: Vec<(String, String)> = rb.cases.iter().map(key).collect();
+    let b_keys: BTreeSet<CaseKey> = rb.cases.iter().map(CaseResult::key).collect();
     let only_in_a = ra
         .cases
         .iter()
-        .filter(|c| !b_keys.contains(&key(c)))
+        .filter(|c| !b_keys.contains(&c.key()))
         .map(|c| format!("{} / {}", c.scenario, c.method))
         .collect();
     let record =
@@ -323,14 +319,14 @@ fn same_commit_and_inputs(a: &StoredReport, b: &StoredReport) -> bool {
 }
 
 /// The case a finding is about (`Missing` ones are the cases only in A, listed apart).
-fn finding_case(f: &Finding) -> Option<(&String, &String)> {
+fn finding_case(f: &Finding) -> Option<CaseKey> {
     match f {
         Finding::Worse { scenario, method, .. }
         | Finding::Turned { scenario, method, .. }
         | Finding::Failed { scenario, method, .. }
         | Finding::NonFinite { scenario, method, .. }
         | Finding::Better { scenario, method, .. }
-        | Finding::Improved { scenario, method, .. } => Some((scenario, method)),
+        | Finding::Improved { scenario, method, .. } => Some(CaseKey::new(scenario, method)),
         Finding::Missing { .. } => None,
     }
 }
