@@ -249,7 +249,7 @@ impl MethodCatalog {
             Some(_) => return Err(config("`scenarios` must be a list of scenario names".into())),
         };
         let peers = peer_names(&path.with_file_name("peers.toml"));
-        for (name, table) in tables_in_file_order(&text, top).map_err(config)? {
+        for (name, table) in tables_in_file_order(top).map_err(config)? {
             let Some(base) = table.get("method").and_then(toml::Value::as_str) else {
                 return Err(config(format!("[{name}]: a sweep names its base method: method = \"…\"")));
             };
@@ -331,7 +331,8 @@ impl MethodCatalog {
             m.sweeps.retain(|p| p.sweep != name);
         }
         for (position, point) in points.iter().enumerate() {
-            let params = sweep::laid_over(&point.apply(&base.params), &shared);
+            // Sorted again: keys the base lacks would come last ([`in_key_order`]).
+            let params = in_key_order(sweep::laid_over(&point.apply(&base.params), &shared));
             let here = SweepPosition { sweep: name.to_string(), position, values: point.values_text() };
             if params == base.params {
                 self.methods.iter_mut().find(|m| m.name == base.name).expect("the base").sweeps.push(here);
@@ -417,10 +418,10 @@ fn read_tables(path: &Path) -> Result<Vec<(String, toml::Table)>, HarnessError> 
         .map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
     let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
     let table: toml::Table = text.parse().map_err(|e: toml::de::Error| config(e.to_string()))?;
-    tables_in_file_order(&text, table).map_err(config)
+    tables_in_file_order(table).map_err(config)
 }
 
-/// The method names of the peers' file `path` (its top-level tables); none when it is missing or
+/// The method names of the peers' file `path` (its top-level tables, in file order); none when it is missing or
 /// not TOML (the peers' own loading reports that when they are asked for).
 pub fn peer_names(path: &Path) -> Vec<String> {
     std::fs::read_to_string(path)
@@ -430,18 +431,41 @@ pub fn peer_names(path: &Path) -> Vec<String> {
         .unwrap_or_default()
 }
 
-/// The top-level tables of `table`, parsed from `text`, in file order.
-fn tables_in_file_order(text: &str, table: toml::Table) -> Result<Vec<(String, toml::Table)>, String> {
-    let mut tables = Vec::new();
-    for (name, value) in table {
-        let toml::Value::Table(params) = value else {
-            return Err(format!("`{name}` must be a table of parameters, e.g. [{name}]"));
-        };
-        tables.push((name, params));
+/// The top-level tables of the parsed file `top`, in file order (toml's `preserve_order` keeps
+/// it), each with its own keys sorted ([`in_key_order`]); `Err` names a top-level key that is not
+/// a table.
+fn tables_in_file_order(top: toml::Table) -> Result<Vec<(String, toml::Table)>, String> {
+    // Of several keys that are not tables, the first in sorted order is named, as when toml's map
+    // was sorted.
+    if let Some(name) = top.iter().filter(|(_, value)| !value.is_table()).map(|(name, _)| name).min() {
+        return Err(format!("`{name}` must be a table of parameters, e.g. [{name}]"));
     }
-    // toml's map is sorted by key; report order follows the file.
-    tables.sort_by_key(|(name, _)| text.find(&format!("[{name}]")).unwrap_or(usize::MAX));
-    Ok(tables)
+    let tables = top.into_iter().filter_map(|(name, value)| match value {
+        toml::Value::Table(table) => Some((name, in_key_order(table))),
+        _ => None,
+    });
+    Ok(tables.collect())
+}
+
+/// `table` with its keys, and those of every table within it, in sorted order. toml's
+/// `preserve_order` (enabled for the file order of the entries) keeps an entry's keys in file
+/// order; everything after reading relies on the sorted order toml's map had before: the unknown
+/// key an error names (the first), `params` as a variant's summary writes them, a sweep's keys in
+/// its points' names and in the order of its points ([`sweep::expand`]), and the order
+/// [`methods::registry::create`] checks and names the keys of a parameter error in.
+pub(crate) fn in_key_order(table: toml::Table) -> toml::Table {
+    let mut entries: Vec<(String, toml::Value)> = table.into_iter().collect();
+    entries.sort_by(|(a, _), (b, _)| a.cmp(b));
+    entries.into_iter().map(|(key, value)| (key, value_in_key_order(value))).collect()
+}
+
+/// `value` with the keys of every table within it sorted ([`in_key_order`]).
+fn value_in_key_order(value: toml::Value) -> toml::Value {
+    match value {
+        toml::Value::Table(table) => toml::Value::Table(in_key_order(table)),
+        toml::Value::Array(items) => toml::Value::Array(items.into_iter().map(value_in_key_order).collect()),
+        other => other,
+    }
 }
 
 /// The entry `name` of `path` (its table `table`): a variant of a built-in method (`method`), or an
@@ -485,7 +509,8 @@ fn entry(
         let summary = summary.unwrap_or_else(|| format!("`{base}` with {params}").replace('\n', ", "));
         // The base method as configured, with the variant's own values.
         let params = match catalog.get(base) {
-            Some(configured) => sweep::laid_over(&configured.params, &params),
+            // Keys the base lacks would come last: sorted again, as every entry's keys are.
+            Some(configured) => in_key_order(sweep::laid_over(&configured.params, &params)),
             None => params,
         };
         methods::registry::create(base, &params).map_err(|e| config(e.to_string()))?;
@@ -745,6 +770,43 @@ mod tests {
         assert!(err.contains("[s]") && err.contains("`isolines`"), "{err}");
         let err = load("[s]\nmethod = \"isolines\"\nparams = { isolines = [1] }\n").unwrap_err();
         assert!(err.contains("isolines[isolines=1]"), "{err}");
+    }
+
+    #[test]
+    fn entries_keep_file_order_and_their_keys_the_sorted_order() {
+        // A comment naming a later table does not move it ahead (the order was once found by
+        // searching the text for `[name]`).
+        let catalog = load(
+            "# alpha comes before [beta]\n[alpha]\ncommand = [\"p\"]\n[beta]\ncommand = [\"p\"]\n\
+             [fields]\nmethod = \"hirm\"\nparams = { threshold = 1.001, min_fields = [6, 12], isolines = [5, 10] }\n",
+        )
+        .unwrap();
+        let builtin = methods::registry::METHODS.len();
+        let names: Vec<&str> = catalog.names().skip(builtin).collect();
+        // A sweep's keys in sorted order, whatever the file's: its points' names and order.
+        assert_eq!(
+            names,
+            [
+                "alpha",
+                "beta",
+                "hirm[isolines=5,min_fields=6,threshold=1.001]",
+                "hirm[isolines=5,min_fields=12,threshold=1.001]",
+                "hirm[isolines=10,min_fields=6,threshold=1.001]",
+                "hirm[isolines=10,min_fields=12,threshold=1.001]"
+            ]
+        );
+        let catalog =
+            load("[v]\nmethod = \"arap\"\nparams = { weights = \"cotan\", max_iterations = 5 }\n").unwrap();
+        assert_eq!(
+            catalog.get("v").unwrap().summary,
+            "`arap` with max_iterations = 5, weights = \"cotan\", "
+        );
+        let keys: Vec<&String> = catalog.get("v").unwrap().params.keys().collect();
+        assert_eq!(keys, ["max_iterations", "weights"]);
+        let err = load("[m]\ncommand = [\"p\"]\nzz = 1\nkk = 2\n").unwrap_err();
+        assert!(err.contains("unknown key `kk`"), "{err}");
+        let err = load("b = 1\na = 2\n").unwrap_err();
+        assert!(err.contains("`a` must be a table"), "{err}");
     }
 
     #[test]

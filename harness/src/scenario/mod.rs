@@ -454,7 +454,9 @@ pub fn load_specs(dir: &Path) -> Result<Vec<ScenarioSpec>, HarnessError> {
 /// Read and check one scenario file.
 pub fn load_spec(path: &Path) -> Result<ScenarioSpec, HarnessError> {
     let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
-    let table = read_extended(path, 0)?;
+    // Keys sorted, as toml's map had them before the workspace enabled `preserve_order`: of several
+    // faults in a file, serde names the first it meets.
+    let table = crate::config::in_key_order(read_extended(path, 0)?);
     let mut spec: ScenarioSpec = table.try_into().map_err(|e: toml::de::Error| config(e.to_string()))?;
     spec.path = path.to_path_buf();
     let builtin = spec.survey.is_some() || spec.procedural.is_some();
