@@ -249,7 +249,7 @@ impl MethodCatalog {
             Some(_) => return Err(config("`scenarios` must be a list of scenario names".into())),
         };
         let peers = peer_names(&path.with_file_name("peers.toml"));
-        for (name, table) in tables_in_file_order(&text, top).map_err(config)? {
+        for (name, table) in tables_in_file_order(top).map_err(config)? {
             let Some(base) = table.get("method").and_then(toml::Value::as_str) else {
                 return Err(config(format!("[{name}]: a sweep names its base method: method = \"…\"")));
             };
@@ -292,10 +292,6 @@ impl MethodCatalog {
         given: &[(&str, &str)],
         runs_on: Option<&[String]>,
     ) -> Result<(), HarnessError> {
-        let config = |message: String| HarnessError::Config {
-            path: path.to_path_buf(),
-            message: format!("[{name}]: {message}"),
-        };
         let base_name = table.get("method").and_then(toml::Value::as_str);
         let params = match table.get("params") {
             Some(toml::Value::Table(t)) => t.clone(),
@@ -307,76 +303,95 @@ impl MethodCatalog {
             self.methods.push(method);
             return Ok(());
         };
-        // A sweep: one variant per point, named by its values (the swept ones, then the ones every
-        // point shares), laid over the base method's table.
-        // The base is a method of its own: a built-in one, or an external program or peer (whose
-        // points send it other `params`); not a variant.
-        let base = self
-            .get(base_name)
-            .filter(|m| match &m.implementation {
-                Implementation::BuiltIn(e) => e.name == m.name,
-                Implementation::External(_) => !m.name.contains('['),
-            })
-            .ok_or_else(|| {
-                config(format!(
-                    "`method = \"{base_name}\"`: a sweep varies a built-in, external or peer method (known: {})",
-                    self.names().filter(|n| !n.contains('[')).collect::<Vec<_>>().join(", ")
-                ))
-            })?
-            .clone();
-        let (points, shared) = sweep::expand(&params).map_err(config)?;
-        // A sweep of the same name declared again (sweeps.toml extending methods.toml's) replaces
-        // the earlier one's line.
+        let summary = table.get("summary").and_then(toml::Value::as_str);
+        let sweep = SweepEntry { path, name, summary, runs_on };
+        self.add_sweep(&sweep, base_name, &params).map_err(|message| HarnessError::Config {
+            path: path.to_path_buf(),
+            message: format!("[{name}]: {message}"),
+        })
+    }
+
+    /// Add the points of `sweep`, a sweep of the method `base_name` with the lists of values of
+    /// `params`: one variant per point, named by its values (the swept ones, then the ones every
+    /// point shares), laid over the base method's table. `Err`: what is wrong, without the entry's
+    /// name.
+    fn add_sweep(&mut self, sweep: &SweepEntry, base_name: &str, params: &toml::Table) -> Result<(), String> {
+        let base = self.sweep_base(base_name)?;
+        let (points, shared) = sweep::expand(params)?;
+        self.forget_sweep(sweep.name);
+        for (position, point) in points.iter().enumerate() {
+            self.add_point(sweep, &base, position, point, &shared)?;
+        }
+        Ok(())
+    }
+
+    /// The method `base_name` a sweep varies: a method of its own, a built-in one, or an external
+    /// program or peer (whose points send it other `params`); not a variant. `Err` lists the
+    /// methods a sweep can vary.
+    fn sweep_base(&self, base_name: &str) -> Result<ConfiguredMethod, String> {
+        let base = self.get(base_name).filter(|m| match &m.implementation {
+            Implementation::BuiltIn(e) => e.name == m.name,
+            Implementation::External(_) => !m.name.contains('['),
+        });
+        base.cloned().ok_or_else(|| {
+            format!(
+                "`method = \"{base_name}\"`: a sweep varies a built-in, external or peer method (known: {})",
+                self.names().filter(|n| !n.contains('[')).collect::<Vec<_>>().join(", ")
+            )
+        })
+    }
+
+    /// Take every method out of the sweep `name`: a sweep of the same name declared again
+    /// (sweeps.toml extending methods.toml's) replaces the earlier one's line.
+    fn forget_sweep(&mut self, name: &str) {
         for m in &mut self.methods {
             m.sweeps.retain(|p| p.sweep != name);
         }
-        for (position, point) in points.iter().enumerate() {
-            let params = sweep::laid_over(&point.apply(&base.params), &shared);
-            let here = SweepPosition { sweep: name.to_string(), position, values: point.values_text() };
-            if params == base.params {
-                self.methods.iter_mut().find(|m| m.name == base.name).expect("the base").sweeps.push(here);
-                continue;
-            }
-            let mut named = point.clone();
-            named.values.extend(shared.clone());
-            let point_name = named.name(&base.name);
-            if let Some(existing) = self.methods.iter_mut().find(|m| m.name == point_name) {
-                if existing.params != params {
-                    return Err(config(format!(
-                        "`{point_name}` is configured twice with different parameters"
-                    )));
-                }
-                existing.sweeps.push(here);
-                continue;
-            }
-            let implementation = match &base.implementation {
-                Implementation::BuiltIn(builtin) => {
-                    methods::registry::create(builtin.name, &params)
-                        .map_err(|e| config(format!("{point_name}: {e}")))?;
-                    Implementation::BuiltIn(builtin)
-                }
-                // An external program checks its own parameters when it starts.
-                Implementation::External(e) => Implementation::External(ExternalEntry {
-                    params: serde_json::to_value(&params)
-                        .map_err(|e| config(format!("{point_name}: {e}")))?,
-                    ..e.clone()
-                }),
-            };
-            self.methods.push(ConfiguredMethod {
-                name: point_name,
-                origin: base.origin,
-                params,
-                implementation,
-                summary: match table.get("summary").and_then(toml::Value::as_str) {
-                    Some(s) => format!("{s}: {}", named.values_text()),
-                    None => format!("`{}` with {}", base.name, named.values_text()),
-                },
-                sweeps: vec![here],
-                runs_on: runs_on.map(<[String]>::to_vec),
-                file: path.to_path_buf(),
-                unavailable: base.unavailable.clone(),
-            });
+    }
+
+    /// Add `point`, at `position` of `sweep` (its shared values `shared`), over the method `base`:
+    /// a position of `base` itself when the point's parameters are its own, of the existing method
+    /// of the point's name, else a new method. `Err`: what is wrong, without the entry's name.
+    fn add_point(
+        &mut self,
+        sweep: &SweepEntry,
+        base: &ConfiguredMethod,
+        position: usize,
+        point: &sweep::Point,
+        shared: &toml::Table,
+    ) -> Result<(), String> {
+        // Sorted again: keys the base lacks would come last ([`in_key_order`]).
+        let params = in_key_order(sweep::laid_over(&point.apply(&base.params), shared));
+        let here = SweepPosition { sweep: sweep.name.to_string(), position, values: point.values_text() };
+        if params == base.params {
+            self.methods.iter_mut().find(|m| m.name == base.name).expect("the base").sweeps.push(here);
+            return Ok(());
         }
+        let mut named = point.clone();
+        named.values.extend(shared.clone());
+        let point_name = named.name(&base.name);
+        if let Some(existing) = self.methods.iter_mut().find(|m| m.name == point_name) {
+            if existing.params != params {
+                return Err(format!("`{point_name}` is configured twice with different parameters"));
+            }
+            existing.sweeps.push(here);
+            return Ok(());
+        }
+        let implementation = point_implementation(base, &params).map_err(|e| format!("{point_name}: {e}"))?;
+        self.methods.push(ConfiguredMethod {
+            name: point_name,
+            origin: base.origin,
+            params,
+            implementation,
+            summary: match sweep.summary {
+                Some(s) => format!("{s}: {}", named.values_text()),
+                None => format!("`{}` with {}", base.name, named.values_text()),
+            },
+            sweeps: vec![here],
+            runs_on: sweep.runs_on.map(<[String]>::to_vec),
+            file: sweep.path.to_path_buf(),
+            unavailable: base.unavailable.clone(),
+        });
         Ok(())
     }
 
@@ -417,10 +432,10 @@ fn read_tables(path: &Path) -> Result<Vec<(String, toml::Table)>, HarnessError> 
         .map_err(|error| HarnessError::Io { path: path.to_path_buf(), error })?;
     let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
     let table: toml::Table = text.parse().map_err(|e: toml::de::Error| config(e.to_string()))?;
-    tables_in_file_order(&text, table).map_err(config)
+    tables_in_file_order(table).map_err(config)
 }
 
-/// The method names of the peers' file `path` (its top-level tables); none when it is missing or
+/// The method names of the peers' file `path` (its top-level tables, in file order); none when it is missing or
 /// not TOML (the peers' own loading reports that when they are asked for).
 pub fn peer_names(path: &Path) -> Vec<String> {
     std::fs::read_to_string(path)
@@ -430,18 +445,67 @@ pub fn peer_names(path: &Path) -> Vec<String> {
         .unwrap_or_default()
 }
 
-/// The top-level tables of `table`, parsed from `text`, in file order.
-fn tables_in_file_order(text: &str, table: toml::Table) -> Result<Vec<(String, toml::Table)>, String> {
-    let mut tables = Vec::new();
-    for (name, value) in table {
-        let toml::Value::Table(params) = value else {
-            return Err(format!("`{name}` must be a table of parameters, e.g. [{name}]"));
-        };
-        tables.push((name, params));
+/// The top-level tables of the parsed file `top`, in file order (toml's `preserve_order` keeps
+/// it), each with its own keys sorted ([`in_key_order`]); `Err` names a top-level key that is not
+/// a table.
+fn tables_in_file_order(top: toml::Table) -> Result<Vec<(String, toml::Table)>, String> {
+    // Of several keys that are not tables, the first in sorted order is named, as when toml's map
+    // was sorted.
+    if let Some(name) = top.iter().filter(|(_, value)| !value.is_table()).map(|(name, _)| name).min() {
+        return Err(format!("`{name}` must be a table of parameters, e.g. [{name}]"));
     }
-    // toml's map is sorted by key; report order follows the file.
-    tables.sort_by_key(|(name, _)| text.find(&format!("[{name}]")).unwrap_or(usize::MAX));
-    Ok(tables)
+    let tables = top.into_iter().filter_map(|(name, value)| match value {
+        toml::Value::Table(table) => Some((name, in_key_order(table))),
+        _ => None,
+    });
+    Ok(tables.collect())
+}
+
+/// `table` with its keys, and those of every table within it, in sorted order. toml's
+/// `preserve_order` (enabled for the file order of the entries) keeps an entry's keys in file
+/// order; everything after reading relies on the sorted order toml's map had before: the unknown
+/// key an error names (the first), `params` as a variant's summary writes them, a sweep's keys in
+/// its points' names and in the order of its points ([`sweep::expand`]), and the order
+/// [`methods::registry::create`] checks and names the keys of a parameter error in.
+pub(crate) fn in_key_order(table: toml::Table) -> toml::Table {
+    let mut entries: Vec<(String, toml::Value)> = table.into_iter().collect();
+    entries.sort_by(|(a, _), (b, _)| a.cmp(b));
+    entries.into_iter().map(|(key, value)| (key, value_in_key_order(value))).collect()
+}
+
+/// `value` with the keys of every table within it sorted ([`in_key_order`]).
+fn value_in_key_order(value: toml::Value) -> toml::Value {
+    match value {
+        toml::Value::Table(table) => toml::Value::Table(in_key_order(table)),
+        toml::Value::Array(items) => toml::Value::Array(items.into_iter().map(value_in_key_order).collect()),
+        other => other,
+    }
+}
+
+/// A sweep's entry, as its points need it: its file, its name, its `summary` (the points' begin
+/// with it) and the scenarios its points run on (`None`: every one that does not restrict its
+/// methods).
+struct SweepEntry<'a> {
+    path: &'a Path,
+    name: &'a str,
+    summary: Option<&'a str>,
+    runs_on: Option<&'a [String]>,
+}
+
+/// What runs a sweep point with `params` over the method `base`: `base`'s built-in method (the
+/// parameters checked here), or its external program sent `params` (which checks them when it
+/// starts). `Err`: why the parameters are refused.
+fn point_implementation(base: &ConfiguredMethod, params: &toml::Table) -> Result<Implementation, String> {
+    Ok(match &base.implementation {
+        Implementation::BuiltIn(builtin) => {
+            methods::registry::create(builtin.name, params).map_err(|e| e.to_string())?;
+            Implementation::BuiltIn(builtin)
+        }
+        Implementation::External(e) => Implementation::External(ExternalEntry {
+            params: serde_json::to_value(params).map_err(|e| e.to_string())?,
+            ..e.clone()
+        }),
+    })
 }
 
 /// The entry `name` of `path` (its table `table`): a variant of a built-in method (`method`), or an
@@ -458,39 +522,67 @@ fn entry(
         path: path.to_path_buf(),
         message: format!("[{name}]: {message}"),
     };
-    if !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
-        return Err(config("a method name is letters, digits, `_` and `-` (it names report files)".into()));
+    let entry = Entry::read(path, name, table).map_err(config)?;
+    let method = match table.get("method") {
+        Some(base) => entry.variant(base, catalog),
+        None => entry.external(origin, given),
+    };
+    method.map_err(config)
+}
+
+/// An entry of a method file with the keys every entry may have read: its file, name and table,
+/// its `params` (default empty) and `summary`.
+struct Entry<'a> {
+    path: &'a Path,
+    name: &'a str,
+    table: &'a toml::Table,
+    params: toml::Table,
+    summary: Option<String>,
+}
+
+impl<'a> Entry<'a> {
+    /// The entry `name` of `path` with the table `table`, its name checked (it names report files)
+    /// and its `params` and `summary` read. `Err`: what is wrong, without the entry's name.
+    fn read(path: &'a Path, name: &'a str, table: &'a toml::Table) -> Result<Self, String> {
+        if !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+            return Err("a method name is letters, digits, `_` and `-` (it names report files)".into());
+        }
+        let params = match table.get("params") {
+            None => toml::Table::new(),
+            Some(toml::Value::Table(t)) => t.clone(),
+            Some(_) => return Err("`params` must be a table".into()),
+        };
+        let summary = match table.get("summary") {
+            None => None,
+            Some(toml::Value::String(s)) => Some(s.clone()),
+            Some(_) => return Err("`summary` must be a string".into()),
+        };
+        Ok(Self { path, name, table, params, summary })
     }
-    let params = match table.get("params") {
-        None => toml::Table::new(),
-        Some(toml::Value::Table(t)) => t.clone(),
-        Some(_) => return Err(config("`params` must be a table".into())),
-    };
-    let summary = match table.get("summary") {
-        None => None,
-        Some(toml::Value::String(s)) => Some(s.clone()),
-        Some(_) => return Err(config("`summary` must be a string".into())),
-    };
-    if let Some(base) = table.get("method") {
-        if table.contains_key("command") {
-            return Err(config(
-                "give `method` (a variant of a built-in method) or `command`, not both".into(),
-            ));
+
+    /// The variant of the built-in method `base` (the value of `method`) that this entry is: its
+    /// `params` laid over the base method's table as `catalog` configures it, and checked. `Err`:
+    /// what is wrong, without the entry's name.
+    fn variant(self, base: &toml::Value, catalog: &MethodCatalog) -> Result<ConfiguredMethod, String> {
+        if self.table.contains_key("command") {
+            return Err("give `method` (a variant of a built-in method) or `command`, not both".into());
         }
-        if let Some(key) = table.keys().find(|k| !VARIANT_KEYS.contains(&k.as_str())) {
-            return Err(config(format!("unknown key `{key}` (a variant takes {})", VARIANT_KEYS.join(", "))));
+        if let Some(key) = self.table.keys().find(|k| !VARIANT_KEYS.contains(&k.as_str())) {
+            return Err(format!("unknown key `{key}` (a variant takes {})", VARIANT_KEYS.join(", ")));
         }
-        let base = base.as_str().ok_or_else(|| config("`method` must be a method name".into()))?;
-        let builtin = methods::registry::find(base).map_err(|e| config(e.to_string()))?;
-        let summary = summary.unwrap_or_else(|| format!("`{base}` with {params}").replace('\n', ", "));
+        let base = base.as_str().ok_or_else(|| "`method` must be a method name".to_string())?;
+        let builtin = methods::registry::find(base).map_err(|e| e.to_string())?;
+        let params = self.params;
+        let summary = self.summary.unwrap_or_else(|| format!("`{base}` with {params}").replace('\n', ", "));
         // The base method as configured, with the variant's own values.
         let params = match catalog.get(base) {
-            Some(configured) => sweep::laid_over(&configured.params, &params),
+            // Keys the base lacks would come last: sorted again, as every entry's keys are.
+            Some(configured) => in_key_order(sweep::laid_over(&configured.params, &params)),
             None => params,
         };
-        methods::registry::create(base, &params).map_err(|e| config(e.to_string()))?;
-        return Ok(ConfiguredMethod {
-            name: name.to_string(),
+        methods::registry::create(base, &params).map_err(|e| e.to_string())?;
+        Ok(ConfiguredMethod {
+            name: self.name.to_string(),
             // Our own implementation, whichever file named it.
             origin: Origin::BuiltIn,
             summary,
@@ -498,31 +590,77 @@ fn entry(
             implementation: Implementation::BuiltIn(builtin),
             sweeps: Vec::new(),
             runs_on: None,
-            file: path.to_path_buf(),
+            file: self.path.to_path_buf(),
             unavailable: None,
-        });
+        })
     }
-    if let Some(key) = table.keys().find(|k| !EXTERNAL_KEYS.contains(&k.as_str())) {
-        return Err(config(format!(
-            "unknown key `{key}` (an external method takes {}; its own parameters go in [{name}.params])",
-            EXTERNAL_KEYS.join(", ")
-        )));
+
+    /// The external method of `origin` that this entry is (`command`, `given` variables expanded
+    /// before the environment's): unavailable, with the reason, when this machine lacks what it
+    /// needs. `Err`: what is wrong in the entry, without its name.
+    fn external(self, origin: Origin, given: &[(&str, &str)]) -> Result<ConfiguredMethod, String> {
+        if let Some(key) = self.table.keys().find(|k| !EXTERNAL_KEYS.contains(&k.as_str())) {
+            return Err(format!(
+                "unknown key `{key}` (an external method takes {}; its own parameters go in [{}.params])",
+                EXTERNAL_KEYS.join(", "),
+                self.name
+            ));
+        }
+        let command = command_list(self.table)?;
+        // What the machine lacks (a variable, a directory, a program) disables the entry, not the run.
+        let mut unavailable: Option<String> = None;
+        let command = expanded_command(&command, given, &mut unavailable);
+        let working_dir = working_dir(self.table, self.path, &mut unavailable)?;
+        if unavailable.is_none() {
+            unavailable = program_found(&command[0], &working_dir).err();
+        }
+        let timeout = request_timeout(self.table)?;
+        let iterative = is_iterative(self.table)?;
+        let summary = self.summary.unwrap_or_else(|| format!("external program `{}`", command.join(" ")));
+        let json = serde_json::to_value(&self.params).map_err(|e| format!("params: {e}"))?;
+        let mut command = command.into_iter();
+        Ok(ConfiguredMethod {
+            name: self.name.to_string(),
+            origin,
+            params: self.params,
+            summary,
+            sweeps: Vec::new(),
+            runs_on: None,
+            file: self.path.to_path_buf(),
+            unavailable,
+            implementation: Implementation::External(ExternalEntry {
+                program: command.next().expect("non-empty"),
+                args: command.collect(),
+                working_dir,
+                timeout,
+                params: json,
+                iterative,
+            }),
+        })
     }
-    let command: Vec<String> = match table.get("command") {
+}
+
+/// The `command` of an external method's table, as written: a non-empty list of strings. `Err`:
+/// what it must be.
+fn command_list(table: &toml::Table) -> Result<Vec<String>, String> {
+    match table.get("command") {
         Some(toml::Value::Array(items)) if !items.is_empty() => items
             .iter()
             .map(|v| v.as_str().map(str::to_string))
             .collect::<Option<_>>()
-            .ok_or_else(|| config("`command` must be a list of strings".into()))?,
-        _ => {
-            return Err(config(
-                "`command` must be a non-empty list of strings: [\"program\", \"arg\", …]".into(),
-            ))
-        }
-    };
-    // What the machine lacks (a variable, a directory, a program) disables the entry, not the run.
-    let mut unavailable: Option<String> = None;
-    let command: Vec<String> = command
+            .ok_or_else(|| "`command` must be a list of strings".into()),
+        _ => Err("`command` must be a non-empty list of strings: [\"program\", \"arg\", …]".into()),
+    }
+}
+
+/// `command` with its `${VAR}`s expanded (`given` before the environment's). A part that cannot be
+/// expanded is kept as written and makes the method `unavailable` (the first reason kept).
+fn expanded_command(
+    command: &[String],
+    given: &[(&str, &str)],
+    unavailable: &mut Option<String>,
+) -> Vec<String> {
+    command
         .iter()
         .map(|part| {
             crate::variables::expand_with(part, "the command of an external method", given).unwrap_or_else(
@@ -532,7 +670,18 @@ fn entry(
                 },
             )
         })
-        .collect();
+        .collect()
+}
+
+/// The directory an external method of the file `path` runs in: its `working_dir` (`${VAR}`s
+/// expanded, relative to the file's directory), default the file's directory; canonical when it
+/// exists. One that cannot be expanded or is not a directory makes the method `unavailable` (the
+/// first reason kept). `Err`: `working_dir` is not a string.
+fn working_dir(
+    table: &toml::Table,
+    path: &Path,
+    unavailable: &mut Option<String>,
+) -> Result<PathBuf, String> {
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let working_dir = match table.get("working_dir") {
         None => base.clone(),
@@ -544,50 +693,34 @@ fn entry(
                 base.clone()
             }
         },
-        Some(_) => return Err(config("`working_dir` must be a string".into())),
+        Some(_) => return Err("`working_dir` must be a string".into()),
     };
     if unavailable.is_none() && !working_dir.is_dir() {
-        unavailable = Some(format!("its working_dir {} is not a directory", working_dir.display()));
+        *unavailable = Some(format!("its working_dir {} is not a directory", working_dir.display()));
     }
-    let working_dir = working_dir.canonicalize().unwrap_or(working_dir);
-    if unavailable.is_none() {
-        if let Err(why) = program_found(&command[0], &working_dir) {
-            unavailable = Some(why);
-        }
-    }
-    let timeout = match table.get("timeout_s") {
-        None => methods::external::DEFAULT_TIMEOUT,
+    Ok(working_dir.canonicalize().unwrap_or(working_dir))
+}
+
+/// How long an external method may take over one request: its `timeout_s` (seconds), default
+/// [`methods::external::DEFAULT_TIMEOUT`]. `Err`: not a positive number.
+fn request_timeout(table: &toml::Table) -> Result<Duration, String> {
+    match table.get("timeout_s") {
+        None => Ok(methods::external::DEFAULT_TIMEOUT),
         Some(v) => match v.as_float().or_else(|| v.as_integer().map(|i| i as f64)) {
-            Some(s) if s.is_finite() && s > 0.0 => Duration::from_secs_f64(s),
-            _ => return Err(config("`timeout_s` must be a positive number of seconds".into())),
+            Some(s) if s.is_finite() && s > 0.0 => Ok(Duration::from_secs_f64(s)),
+            _ => Err("`timeout_s` must be a positive number of seconds".into()),
         },
-    };
-    let iterative = match table.get("kind").map(toml::Value::as_str) {
-        None | Some(Some("direct")) => false,
-        Some(Some("iterative")) => true,
-        Some(_) => return Err(config("`kind` is \"direct\" or \"iterative\"".into())),
-    };
-    let summary = summary.unwrap_or_else(|| format!("external program `{}`", command.join(" ")));
-    let json = serde_json::to_value(&params).map_err(|e| config(format!("params: {e}")))?;
-    let mut command = command.into_iter();
-    Ok(ConfiguredMethod {
-        name: name.to_string(),
-        origin,
-        params,
-        summary,
-        sweeps: Vec::new(),
-        runs_on: None,
-        file: path.to_path_buf(),
-        unavailable,
-        implementation: Implementation::External(ExternalEntry {
-            program: command.next().expect("non-empty"),
-            args: command.collect(),
-            working_dir,
-            timeout,
-            params: json,
-            iterative,
-        }),
-    })
+    }
+}
+
+/// Whether an external method is iterative: its `kind`, `"direct"` (the default) or
+/// `"iterative"`. `Err`: another value.
+fn is_iterative(table: &toml::Table) -> Result<bool, String> {
+    match table.get("kind").map(toml::Value::as_str) {
+        None | Some(Some("direct")) => Ok(false),
+        Some(Some("iterative")) => Ok(true),
+        Some(_) => Err("`kind` is \"direct\" or \"iterative\"".into()),
+    }
 }
 
 /// Whether `program` can be started from `working_dir`: a path (with a `/`) names a file there or
@@ -745,6 +878,43 @@ mod tests {
         assert!(err.contains("[s]") && err.contains("`isolines`"), "{err}");
         let err = load("[s]\nmethod = \"isolines\"\nparams = { isolines = [1] }\n").unwrap_err();
         assert!(err.contains("isolines[isolines=1]"), "{err}");
+    }
+
+    #[test]
+    fn entries_keep_file_order_and_their_keys_the_sorted_order() {
+        // A comment naming a later table does not move it ahead (the order was once found by
+        // searching the text for `[name]`).
+        let catalog = load(
+            "# alpha comes before [beta]\n[alpha]\ncommand = [\"p\"]\n[beta]\ncommand = [\"p\"]\n\
+             [fields]\nmethod = \"hirm\"\nparams = { threshold = 1.001, min_fields = [6, 12], isolines = [5, 10] }\n",
+        )
+        .unwrap();
+        let builtin = methods::registry::METHODS.len();
+        let names: Vec<&str> = catalog.names().skip(builtin).collect();
+        // A sweep's keys in sorted order, whatever the file's: its points' names and order.
+        assert_eq!(
+            names,
+            [
+                "alpha",
+                "beta",
+                "hirm[isolines=5,min_fields=6,threshold=1.001]",
+                "hirm[isolines=5,min_fields=12,threshold=1.001]",
+                "hirm[isolines=10,min_fields=6,threshold=1.001]",
+                "hirm[isolines=10,min_fields=12,threshold=1.001]"
+            ]
+        );
+        let catalog =
+            load("[v]\nmethod = \"arap\"\nparams = { weights = \"cotan\", max_iterations = 5 }\n").unwrap();
+        assert_eq!(
+            catalog.get("v").unwrap().summary,
+            "`arap` with max_iterations = 5, weights = \"cotan\", "
+        );
+        let keys: Vec<&String> = catalog.get("v").unwrap().params.keys().collect();
+        assert_eq!(keys, ["max_iterations", "weights"]);
+        let err = load("[m]\ncommand = [\"p\"]\nzz = 1\nkk = 2\n").unwrap_err();
+        assert!(err.contains("unknown key `kk`"), "{err}");
+        let err = load("b = 1\na = 2\n").unwrap_err();
+        assert!(err.contains("`a` must be a table"), "{err}");
     }
 
     #[test]

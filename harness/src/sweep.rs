@@ -67,7 +67,11 @@ pub fn is_sweep(params: &toml::Table) -> bool {
 pub fn expand(params: &toml::Table) -> Result<(Vec<Point>, toml::Table), String> {
     let mut fixed = toml::Table::new();
     let mut swept: Vec<(&String, &Vec<toml::Value>)> = Vec::new();
-    for (k, v) in params {
+    // Key order is sorted order: toml's map keeps the file's (the workspace enables its
+    // `preserve_order`), and the points' names and order were always in sorted key order.
+    let mut sorted: Vec<(&String, &toml::Value)> = params.iter().collect();
+    sorted.sort_by(|(a, _), (b, _)| a.cmp(b));
+    for (k, v) in sorted {
         match v {
             toml::Value::Array(values) => {
                 if values.is_empty() {

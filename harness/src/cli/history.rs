@@ -233,126 +233,161 @@ fn forget_target(
 pub(super) fn run(command: HistoryCommand) -> anyhow::Result<ExitCode> {
     match command {
         HistoryCommand::Record { reports, store, allow_mixed, allow_dirty } => {
-            let path = store.path();
-            // Every run is read and checked before the store is touched: a bad file records nothing.
-            let runs = reports.iter().map(|r| run_record::read_run(r)).collect::<Result<Vec<_>, _>>()?;
-            if let Some((r, _)) = reports.iter().zip(&runs).find(|(_, run)| run.dirty && !allow_dirty) {
-                anyhow::bail!(
-                    "{}: made from a tree that differed from its commit (git_dirty); its values belong to no commit. --allow-dirty records it as a point of its own (the commit, +dirty: and its diff's hash)",
-                    r.display()
-                );
-            }
-            let mut history = HistoryStore::open_or_create(&path)?;
             let mixing = if allow_mixed { Mixing::Allow } else { Mixing::Refuse };
-            // All or nothing: one transaction, in which each run is also judged against the runs
-            // before it in this call.
-            let sources: Vec<(&run_record::RunRecord, String)> =
-                runs.iter().zip(&reports).map(|(run, r)| (run, r.display().to_string())).collect();
-            let outcomes = match history.record_all(&sources, mixing) {
-                Ok(outcomes) => outcomes,
-                Err(e) => {
-                    history.abandon();
-                    return Err(anyhow::Error::new(e)
-                        .context(format!("nothing of the {} run(s) was recorded", runs.len())));
-                }
-            };
-            for ((r, run), outcome) in reports.iter().zip(&runs).zip(outcomes) {
-                let point =
-                    run_record::point_label(&run.commit, 12, run.diff.as_deref().or(run.dirty.then_some("")));
-                let label = format!("{} ({point})", r.display());
-                print_outcome(&label, &Outcome::Recorded(outcome));
-            }
-            println!("store: {}", path.display());
-            Ok(ExitCode::SUCCESS)
+            record(&reports, &store.path(), mixing, allow_dirty)
         }
         HistoryCommand::Run { revisions, steps, store, suite } => {
-            let path = store.path();
-            let options = suite.options(&path)?;
-            let mut commits = git::expand(&options.repo, &revisions)?;
-            if let Some(n) = steps {
-                commits = git::thin(&commits, n as usize);
-            }
-            let mut history = HistoryStore::open_or_create(&path)?;
-            println!("{} commit(s) to run: {}", commits.len(), options.request());
-            let total = commits.len();
-            let outcomes = collect::run_commits(&mut history, &commits, &options, |i, sha, outcome| {
-                print_outcome(&format!("[{}/{total}] {}", i + 1, &sha[..12]), outcome)
-            })?;
-            let failed = outcomes.iter().filter(|o| matches!(o, Outcome::Failed { .. })).count();
-            println!("store: {}", path.display());
-            Ok(if failed > 0 { ExitCode::from(super::EXIT_CASE_FAILED) } else { ExitCode::SUCCESS })
+            run_revisions(&revisions, steps, &store, &suite)
         }
-        HistoryCommand::Forget { commits, store, repo } => {
-            let path = store.path();
-            let mut history = HistoryStore::open_existing(&path)?;
-            // Without a repository a commit is still found among the stored by its first digits.
-            let repo = match repo {
-                Some(dir) => Some(history::repository(Some(&dir))?),
-                None => history::repository(None).ok(),
-            };
-            let stored = history.stored_commits()?;
-            // Every name is resolved and checked first: one that names no stored commit removes
-            // nothing, not even the runs of the others.
-            let shas = commits
-                .iter()
-                .map(|c| forget_target(c, repo.as_deref(), &stored, &path))
-                .collect::<anyhow::Result<Vec<_>>>()?;
-            for (c, n) in commits.iter().zip(history.forget_all(&shas)?) {
-                println!("{c}: {n} run(s) removed");
-            }
-            Ok(ExitCode::SUCCESS)
-        }
-        HistoryCommand::Show { store, out, repo } => {
-            let path = store.path();
-            let history_store = HistoryStore::open_existing(&path)?;
-            let repo = history::repository(repo.as_deref())?;
-            let built = timeline::build(&history_store, &repo)?;
-            let out = out.unwrap_or_else(|| path.parent().unwrap_or(std::path::Path::new(".")).join("page"));
-            let index = page::write_page(&out, &built, &path)?;
-            let steps = page::all_steps(&built);
-            println!(
-                "{}, {} timelines, {} step(s){}",
-                page::points_text(&built),
-                built.timelines.len(),
-                steps.len(),
-                if steps.is_empty() { "" } else { ":" }
-            );
-            for (t, s) in steps {
-                println!("  {}", page::step_line(&built, t, s));
-            }
-            println!("history page: {}", index.display());
-            Ok(ExitCode::SUCCESS)
-        }
+        HistoryCommand::Forget { commits, store, repo } => forget(&commits, &store.path(), repo),
+        HistoryCommand::Show { store, out, repo } => show(&store.path(), out, repo.as_deref()),
         HistoryCommand::Find { measure, scenario, method, store, suite } => {
-            let measure = Measure::from_key(&measure).ok_or_else(|| {
-                let keys: Vec<&str> = Measure::all().into_iter().map(Measure::key).collect();
-                anyhow::anyhow!("unknown measure `{measure}`; one of {}", keys.join(", "))
-            })?;
-            let path = store.path();
-            let options = suite.options(&path)?;
-            let mut history_store = HistoryStore::open_existing(&path)?;
-            let target = FindTarget { measure, scenario, method };
-            let found = collect::find(&mut history_store, &target, &options, |sha, outcome| {
-                print_outcome(&format!("bisect {}", &sha[..12]), outcome)
-            })?;
-            if found.is_empty() {
-                println!("no step of {} found", measure.key());
-            }
-            for f in &found {
-                println!(
-                    "{} / {} {}: {:.4} -> {:.4} ({:+.1}%), made by {} {} ({} commit(s) run)",
-                    f.scenario,
-                    f.method,
-                    measure.key(),
-                    f.step.before,
-                    f.step.after,
-                    100.0 * f.step.relative,
-                    f.commit.label(),
-                    page::short_subject(&f.commit.subject),
-                    f.runs
-                );
-            }
-            Ok(ExitCode::SUCCESS)
+            find(&measure, scenario, method, &store.path(), &suite)
         }
     }
+}
+
+/// `history record`: store the runs of `reports` (report directories or results.json files) in the
+/// store at `path`, all or none; a run of a dirty tree only with `allow_dirty`.
+fn record(reports: &[PathBuf], path: &Path, mixing: Mixing, allow_dirty: bool) -> anyhow::Result<ExitCode> {
+    // Every run is read and checked before the store is touched: a bad file records nothing.
+    let runs = reports.iter().map(|r| run_record::read_run(r)).collect::<Result<Vec<_>, _>>()?;
+    if let Some((r, _)) = reports.iter().zip(&runs).find(|(_, run)| run.dirty && !allow_dirty) {
+        anyhow::bail!(
+            "{}: made from a tree that differed from its commit (git_dirty); its values belong to no commit. --allow-dirty records it as a point of its own (the commit, +dirty: and its diff's hash)",
+            r.display()
+        );
+    }
+    let mut history = HistoryStore::open_or_create(path)?;
+    // All or nothing: one transaction, in which each run is also judged against the runs
+    // before it in this call.
+    let sources: Vec<(&run_record::RunRecord, String)> =
+        runs.iter().zip(reports).map(|(run, r)| (run, r.display().to_string())).collect();
+    let outcomes = match history.record_all(&sources, mixing) {
+        Ok(outcomes) => outcomes,
+        Err(e) => {
+            history.abandon();
+            return Err(
+                anyhow::Error::new(e).context(format!("nothing of the {} run(s) was recorded", runs.len()))
+            );
+        }
+    };
+    for ((r, run), outcome) in reports.iter().zip(&runs).zip(outcomes) {
+        let point = run_record::point_label(&run.commit, 12, run.diff.as_deref().or(run.dirty.then_some("")));
+        let label = format!("{} ({point})", r.display());
+        print_outcome(&label, &Outcome::Recorded(outcome));
+    }
+    println!("store: {}", path.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `history run`: run and record each commit of `revisions` (`steps` of them, evenly spread, when
+/// given) in the store of `store`, with the suite `suite`. Exits with the failed-case code when a
+/// commit failed to build or run.
+fn run_revisions(
+    revisions: &[String],
+    steps: Option<u32>,
+    store: &StoreArgs,
+    suite: &SuiteArgs,
+) -> anyhow::Result<ExitCode> {
+    let path = store.path();
+    let options = suite.options(&path)?;
+    let mut commits = git::expand(&options.repo, revisions)?;
+    if let Some(n) = steps {
+        commits = git::thin(&commits, n as usize);
+    }
+    let mut history = HistoryStore::open_or_create(&path)?;
+    println!("{} commit(s) to run: {}", commits.len(), options.request());
+    let total = commits.len();
+    let outcomes = collect::run_commits(&mut history, &commits, &options, |i, sha, outcome| {
+        print_outcome(&format!("[{}/{total}] {}", i + 1, &sha[..12]), outcome)
+    })?;
+    let failed = outcomes.iter().filter(|o| matches!(o, Outcome::Failed { .. })).count();
+    println!("store: {}", path.display());
+    Ok(if failed > 0 { ExitCode::from(super::EXIT_CASE_FAILED) } else { ExitCode::SUCCESS })
+}
+
+/// `history forget`: remove every run of `commits` (named in `repo`, or by their first digits
+/// among the stored) from the store at `path`; nothing when one of them names no stored commit.
+fn forget(commits: &[String], path: &Path, repo: Option<PathBuf>) -> anyhow::Result<ExitCode> {
+    let mut history = HistoryStore::open_existing(path)?;
+    // Without a repository a commit is still found among the stored by its first digits.
+    let repo = match repo {
+        Some(dir) => Some(history::repository(Some(&dir))?),
+        None => history::repository(None).ok(),
+    };
+    let stored = history.stored_commits()?;
+    // Every name is resolved and checked first: one that names no stored commit removes
+    // nothing, not even the runs of the others.
+    let shas = commits
+        .iter()
+        .map(|c| forget_target(c, repo.as_deref(), &stored, path))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    for (c, n) in commits.iter().zip(history.forget_all(&shas)?) {
+        println!("{c}: {n} run(s) removed");
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `history show`: write the history page of the store at `path` to `out` (default: `page` next to
+/// the store), commits in the order of `repo`'s history, and print its steps.
+fn show(path: &Path, out: Option<PathBuf>, repo: Option<&Path>) -> anyhow::Result<ExitCode> {
+    let history_store = HistoryStore::open_existing(path)?;
+    let repo = history::repository(repo)?;
+    let built = timeline::build(&history_store, &repo)?;
+    let out = out.unwrap_or_else(|| path.parent().unwrap_or(std::path::Path::new(".")).join("page"));
+    let index = page::write_page(&out, &built, path)?;
+    let steps = page::all_steps(&built);
+    println!(
+        "{}, {} timelines, {} step(s){}",
+        page::points_text(&built),
+        built.timelines.len(),
+        steps.len(),
+        if steps.is_empty() { "" } else { ":" }
+    );
+    for (t, s) in steps {
+        println!("  {}", page::step_line(&built, t, s));
+    }
+    println!("history page: {}", index.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `history find`: bisect the steps of the measure named `measure` (of `scenario` and `method`
+/// when given) in the store at `path`, running commits with the suite `suite`, and print the
+/// commit that made each.
+fn find(
+    measure: &str,
+    scenario: Option<String>,
+    method: Option<String>,
+    path: &Path,
+    suite: &SuiteArgs,
+) -> anyhow::Result<ExitCode> {
+    let measure = Measure::from_key(measure).ok_or_else(|| {
+        let keys: Vec<&str> = Measure::all().into_iter().map(Measure::key).collect();
+        anyhow::anyhow!("unknown measure `{measure}`; one of {}", keys.join(", "))
+    })?;
+    let options = suite.options(path)?;
+    let mut history_store = HistoryStore::open_existing(path)?;
+    let target = FindTarget { measure, scenario, method };
+    let found = collect::find(&mut history_store, &target, &options, |sha, outcome| {
+        print_outcome(&format!("bisect {}", &sha[..12]), outcome)
+    })?;
+    if found.is_empty() {
+        println!("no step of {} found", measure.key());
+    }
+    for f in &found {
+        println!(
+            "{} / {} {}: {:.4} -> {:.4} ({:+.1}%), made by {} {} ({} commit(s) run)",
+            f.scenario,
+            f.method,
+            measure.key(),
+            f.step.before,
+            f.step.after,
+            100.0 * f.step.relative,
+            f.commit.label(),
+            page::short_subject(&f.commit.subject),
+            f.runs
+        );
+    }
+    Ok(ExitCode::SUCCESS)
 }

@@ -73,88 +73,141 @@ pub fn run_commits(
     Ok(outcomes)
 }
 
+/// Run and record the commit `sha` for `request` (see the module doc), unless it is recorded for
+/// it already or failed before and is not to be retried. A build or run that fails is recorded as
+/// the commit's failure and is an outcome, not an error.
 fn run_commit(
     store: &mut HistoryStore,
     sha: &str,
     options: &CollectOptions,
     request: &str,
 ) -> Result<Outcome, HistoryError> {
-    if store.has_request(sha, request)? {
-        return Ok(Outcome::AlreadyRecorded);
+    if let Some(outcome) = earlier_outcome(store, sha, options.retry_failed, request)? {
+        return Ok(outcome);
     }
-    if let Some(f) = store.failures()?.into_iter().find(|f| f.commit == sha && f.request == request) {
-        if !options.retry_failed {
-            return Ok(Outcome::FailedBefore(format!("{}: {}", f.stage, f.message)));
-        }
-        store.clear_failure(sha, request)?;
-    }
-    let work = &options.work_dir;
-    let io = |path: &Path| {
-        let path = path.to_path_buf();
-        move |error| HistoryError::Io { path: path.clone(), error }
-    };
-    for dir in ["logs", "results"] {
-        std::fs::create_dir_all(work.join(dir)).map_err(io(&work.join(dir)))?;
-    }
-    let worktree = work.join("worktree");
-    let target = work.join("target");
-    let log_path = work.join("logs").join(format!("{sha}.log"));
+    let work = CommitWork::new(&options.work_dir, sha)?;
     let fail = |store: &HistoryStore, stage: &str, message: String| -> Result<Outcome, HistoryError> {
-        let message = format!("{message} (log: {})", log_path.display());
-        store.record_failure(&Failure {
-            commit: sha.to_string(),
-            request: request.to_string(),
-            stage: stage.into(),
-            message: message.clone(),
-        })?;
-        Ok(Outcome::Failed { stage: stage.into(), message })
+        let message = format!("{message} (log: {})", work.log.display());
+        let failure = Failure { commit: sha.into(), request: request.into(), stage: stage.into(), message };
+        store.record_failure(&failure)?;
+        Ok(Outcome::Failed { stage: failure.stage, message: failure.message })
     };
-    git::checkout_worktree(&options.repo, &worktree, sha)?;
-    let log = std::fs::File::create(&log_path).map_err(io(&log_path))?;
-    let build = Command::new("cargo")
-        .args(["build", "--release", "--quiet", "-p", "harness", "--bin", "harness"])
-        .current_dir(&worktree)
-        .env("CARGO_TARGET_DIR", &target)
-        .stdout(log.try_clone().map_err(io(&log_path))?)
-        .stderr(log.try_clone().map_err(io(&log_path))?)
-        .status();
-    match build {
-        Ok(s) if s.success() => {}
-        Ok(s) => return fail(store, "build", format!("cargo build exited with {s}")),
-        Err(e) => return fail(store, "build", format!("cannot start cargo: {e}")),
+    git::checkout_worktree(&options.repo, &work.worktree, sha)?;
+    let log = std::fs::File::create(&work.log).map_err(io_error(&work.log))?;
+    if let Err(message) = work.build(&log)? {
+        return fail(store, "build", message);
     }
-    let reports = work.join("runs").join(sha);
-    let _ = std::fs::remove_dir_all(&reports);
-    let binary = target.join("release/harness");
-    let run = Command::new(&binary)
-        .arg("all")
-        .args(&options.suite_args)
-        .args(["--quiet", "--no-check", "--reports"])
-        .arg(&reports)
-        .current_dir(&worktree)
-        .stdout(log.try_clone().map_err(io(&log_path))?)
-        .stderr(log)
-        .status();
-    let results = reports.join("results.json");
-    match run {
-        // A run with failed cases exits non-zero and still wrote its record: failures are data.
-        Ok(_) if results.is_file() => {}
-        Ok(s) => {
-            return fail(store, "run", format!("`harness all` exited with {s} and wrote no results.json"))
-        }
-        Err(e) => return fail(store, "run", format!("cannot start {}: {e}", binary.display())),
-    }
+    let results = match work.run_suite(&options.suite_args, log)? {
+        Ok(results) => results,
+        Err(message) => return fail(store, "run", message),
+    };
     let record = read_run(&results)?;
     if record.commit != sha {
         return fail(store, "run", format!("the run says it is of commit {}, not {sha}", record.commit));
     }
-    let kept = work.join("results").join(format!("{sha}.json"));
-    std::fs::copy(&results, &kept).map_err(io(&kept))?;
+    std::fs::copy(&results, &work.kept).map_err(io_error(&work.kept))?;
     let recorded =
-        store.record_request(&record, &kept.display().to_string(), options.mixing, Some(request))?;
+        store.record_request(&record, &work.kept.display().to_string(), options.mixing, Some(request))?;
     // The report's pictures and meshes are not kept: results.json is the record.
-    let _ = std::fs::remove_dir_all(&reports);
+    let _ = std::fs::remove_dir_all(&work.reports);
     Ok(Outcome::Recorded(recorded))
+}
+
+/// What came of `sha` for `request` before: recorded already, or failed (unless `retry_failed`,
+/// which clears the failure). `None`: it is to be run.
+fn earlier_outcome(
+    store: &mut HistoryStore,
+    sha: &str,
+    retry_failed: bool,
+    request: &str,
+) -> Result<Option<Outcome>, HistoryError> {
+    if store.has_request(sha, request)? {
+        return Ok(Some(Outcome::AlreadyRecorded));
+    }
+    if let Some(f) = store.failures()?.into_iter().find(|f| f.commit == sha && f.request == request) {
+        if !retry_failed {
+            return Ok(Some(Outcome::FailedBefore(format!("{}: {}", f.stage, f.message))));
+        }
+        store.clear_failure(sha, request)?;
+    }
+    Ok(None)
+}
+
+/// The error of the file operation on `path`.
+fn io_error(path: &Path) -> impl Fn(std::io::Error) -> HistoryError {
+    let path = path.to_path_buf();
+    move |error| HistoryError::Io { path: path.clone(), error }
+}
+
+/// Where the work on one commit goes, under the work directory: the worktree and target directory
+/// every commit shares, the commit's log, its report directory and its kept results.json.
+struct CommitWork {
+    worktree: PathBuf,
+    target: PathBuf,
+    log: PathBuf,
+    reports: PathBuf,
+    kept: PathBuf,
+}
+
+impl CommitWork {
+    /// The work on `sha` under `work_dir`, whose `logs` and `results` directories are made.
+    fn new(work_dir: &Path, sha: &str) -> Result<Self, HistoryError> {
+        for dir in ["logs", "results"] {
+            std::fs::create_dir_all(work_dir.join(dir)).map_err(io_error(&work_dir.join(dir)))?;
+        }
+        Ok(Self {
+            worktree: work_dir.join("worktree"),
+            target: work_dir.join("target"),
+            log: work_dir.join("logs").join(format!("{sha}.log")),
+            reports: work_dir.join("runs").join(sha),
+            kept: work_dir.join("results").join(format!("{sha}.json")),
+        })
+    }
+
+    /// Build the harness of the commit checked out in the worktree (`cargo build --release`, in the
+    /// shared target directory), its output to `log`. `Ok(Err(why))`: the build failed.
+    fn build(&self, log: &std::fs::File) -> Result<Result<(), String>, HistoryError> {
+        let build = Command::new("cargo")
+            .args(["build", "--release", "--quiet", "-p", "harness", "--bin", "harness"])
+            .current_dir(&self.worktree)
+            .env("CARGO_TARGET_DIR", &self.target)
+            .stdout(log.try_clone().map_err(io_error(&self.log))?)
+            .stderr(log.try_clone().map_err(io_error(&self.log))?)
+            .status();
+        Ok(match build {
+            Ok(s) if s.success() => Ok(()),
+            Ok(s) => Err(format!("cargo build exited with {s}")),
+            Err(e) => Err(format!("cannot start cargo: {e}")),
+        })
+    }
+
+    /// Run the suite with the commit's harness (`harness all`, `suite_args` and `--quiet --no-check`,
+    /// into a fresh report directory), its output to `log`. The results.json it wrote, or
+    /// `Ok(Err(why))`: it wrote none.
+    fn run_suite(
+        &self,
+        suite_args: &[String],
+        log: std::fs::File,
+    ) -> Result<Result<PathBuf, String>, HistoryError> {
+        let _ = std::fs::remove_dir_all(&self.reports);
+        let binary = self.target.join("release/harness");
+        let run = Command::new(&binary)
+            .arg("all")
+            .args(suite_args)
+            .args(["--quiet", "--no-check", "--reports"])
+            .arg(&self.reports)
+            .current_dir(&self.worktree)
+            .stdout(log.try_clone().map_err(io_error(&self.log))?)
+            .stderr(log)
+            .status();
+        let results = self.reports.join("results.json");
+        Ok(match run {
+            // A run with failed cases exits non-zero and still wrote its record: failures are data.
+            Ok(_) if results.is_file() => Ok(results),
+            Ok(s) => Err(format!("`harness all` exited with {s} and wrote no results.json")),
+            Err(e) => Err(format!("cannot start {}: {e}", binary.display())),
+        })
+    }
 }
 
 /// The case and measure `history find` bisects.

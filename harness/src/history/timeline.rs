@@ -9,7 +9,7 @@ use std::path::Path;
 use super::git::{self, CommitInfo};
 use super::measures::Measure;
 use super::steps::{self, Observation};
-use super::store::HistoryStore;
+use super::store::{HistoryStore, StoredRun};
 use super::HistoryError;
 
 /// One point: a commit's value of the measure (or an uncommitted change's, [`CommitInfo::dirty`]).
@@ -87,26 +87,58 @@ fn status_kind(status: &str) -> &str {
     status.split(':').next().unwrap_or(status).trim()
 }
 
+/// A point of the history: a commit, and the hash of the diff of a dirty tree (`None`: the
+/// commit's own tree).
+type PointKey = (String, Option<String>);
+
+/// A case's measure in one series: (series, scenario, method, measure).
+type CaseMeasure = (String, String, String, Measure);
+
+/// A value as stored: (value, low, high, run id).
+type StoredPoint = (f64, f64, f64, i64);
+
 /// Build every timeline of `store`, ordering commits by `repo`'s history (by commit time where
 /// git does not know them, then by record). Runs of one commit are one point, and runs of its tree
 /// with an uncommitted change another for each change (its diff's hash), after the commit.
 pub fn build(store: &HistoryStore, repo: &Path) -> Result<History, HistoryError> {
     let runs = store.runs()?;
-    // A point: (commit, diff of a dirty tree).
-    type PointKey = (String, Option<String>);
-    let mut shas: Vec<String> = Vec::new();
-    let mut keys: Vec<PointKey> = Vec::new();
-    for r in &runs {
-        if !shas.contains(&r.commit) {
-            shas.push(r.commit.clone());
-        }
-        let key = (r.commit.clone(), r.dirty.clone());
-        if !keys.contains(&key) {
-            keys.push(key);
+    let shas = distinct(runs.iter().map(|r| r.commit.clone()));
+    let infos = git::infos(repo, &shas);
+    let keys = ordered_points(&runs, &infos, &git::topological_order(repo));
+    let commits: Vec<CommitInfo> = keys.iter().map(|key| point_commit(key, &infos)).collect();
+    let method_change = method_changes(repo, &commits);
+    let statuses = store.statuses()?;
+    let timelines: Vec<Timeline> = grouped_values(store, &runs, &keys)?
+        .into_iter()
+        .map(|(case, by_commit)| timeline(case, by_commit, &statuses, &commits))
+        .collect();
+    let mut series: Vec<String> = runs.iter().map(|r| r.series.clone()).collect();
+    series.sort();
+    series.dedup();
+    let status_changes = status_changes(&timelines);
+    Ok(History { commits, method_change, series, timelines, status_changes })
+}
+
+/// `items` without repeats, each where it first comes.
+fn distinct<T: PartialEq>(items: impl Iterator<Item = T>) -> Vec<T> {
+    let mut out = Vec::new();
+    for item in items {
+        if !out.contains(&item) {
+            out.push(item);
         }
     }
-    let infos = git::infos(repo, &shas);
-    let order = git::topological_order(repo);
+    out
+}
+
+/// The points of `runs` (in record order) in the repository's order: by `order` (git's
+/// topological order), then by commit time (`infos`), a commit before its dirty trees, then by
+/// first record.
+fn ordered_points(
+    runs: &[StoredRun],
+    infos: &HashMap<String, CommitInfo>,
+    order: &HashMap<String, usize>,
+) -> Vec<PointKey> {
+    let mut keys = distinct(runs.iter().map(|r| (r.commit.clone(), r.dirty.clone())));
     // Runs are in record order, so the first run of each key is its first record.
     let first_record: HashMap<PointKey, usize> =
         runs.iter().enumerate().rev().map(|(i, r)| ((r.commit.clone(), r.dirty.clone()), i)).collect();
@@ -118,22 +150,28 @@ pub fn build(store: &HistoryStore, repo: &Path) -> Result<History, HistoryError>
             first_record[k],
         )
     });
-    let commits: Vec<CommitInfo> = keys
-        .iter()
-        .map(|(s, dirty)| {
-            let info = infos.get(s).cloned().unwrap_or(CommitInfo {
-                sha: s.clone(),
-                dirty: None,
-                time: 0,
-                date: String::new(),
-                subject: "(not in this repository)".into(),
-                parent: None,
-            });
-            CommitInfo { dirty: dirty.clone(), ..info }
-        })
-        .collect();
-    let index: HashMap<&PointKey, usize> = keys.iter().enumerate().map(|(i, k)| (k, i)).collect();
-    let method_change: Vec<Option<bool>> = commits
+    keys
+}
+
+/// The commit of the point `key` as git tells it (`infos`; a placeholder for a commit not in the
+/// repository), with its dirty tree's diff hash.
+fn point_commit((sha, dirty): &PointKey, infos: &HashMap<String, CommitInfo>) -> CommitInfo {
+    let info = infos.get(sha).cloned().unwrap_or(CommitInfo {
+        sha: sha.clone(),
+        dirty: None,
+        time: 0,
+        date: String::new(),
+        subject: "(not in this repository)".into(),
+        parent: None,
+    });
+    CommitInfo { dirty: dirty.clone(), ..info }
+}
+
+/// Whether each of `commits` changed method code since the one before it (the first: since its
+/// parent), as git in `repo` tells; `None` for an uncommitted change, whose files are not in git,
+/// or where git cannot tell.
+fn method_changes(repo: &Path, commits: &[CommitInfo]) -> Vec<Option<bool>> {
+    commits
         .iter()
         .enumerate()
         .map(|(i, c)| {
@@ -144,16 +182,22 @@ pub fn build(store: &HistoryStore, repo: &Path) -> Result<History, HistoryError>
             let before = if i == 0 { c.parent.clone()? } else { commits[i - 1].sha.clone() };
             git::changed_files(repo, &before, &c.sha).ok().map(|f| git::touches_methods(&f))
         })
-        .collect();
+        .collect()
+}
 
+/// The stored values of `store`, by case measure and then by point (its index in `keys`, the
+/// points in order), each run's of `runs` under its own point.
+fn grouped_values(
+    store: &HistoryStore,
+    runs: &[StoredRun],
+    keys: &[PointKey],
+) -> Result<BTreeMap<CaseMeasure, BTreeMap<usize, Vec<StoredPoint>>>, HistoryError> {
+    let index: HashMap<&PointKey, usize> = keys.iter().enumerate().map(|(i, k)| (k, i)).collect();
     let run_of: HashMap<i64, (usize, &str)> = runs
         .iter()
         .map(|r| (r.id, (index[&(r.commit.clone(), r.dirty.clone())], r.series.as_str())))
         .collect();
-    let statuses = store.statuses()?;
-    // (series, scenario, method, measure) -> commit -> values (value, low, high, run id)
-    type Key = (String, String, String, Measure);
-    let mut grouped: BTreeMap<Key, BTreeMap<usize, Vec<(f64, f64, f64, i64)>>> = BTreeMap::new();
+    let mut grouped: BTreeMap<CaseMeasure, BTreeMap<usize, Vec<StoredPoint>>> = BTreeMap::new();
     for v in store.values()? {
         let (commit, series) = run_of[&v.run];
         grouped
@@ -163,50 +207,79 @@ pub fn build(store: &HistoryStore, repo: &Path) -> Result<History, HistoryError>
             .or_default()
             .push((v.value, v.low, v.high, v.run));
     }
-    let mut timelines = Vec::new();
-    for ((series, scenario, method, measure), by_commit) in grouped {
-        let points: Vec<Point> = by_commit
-            .into_iter()
-            .map(|(commit, mut values)| {
-                values.sort_by(|a, b| a.0.total_cmp(&b.0));
-                let value = values[values.len() / 2].0;
-                let low = values.iter().map(|v| v.1).fold(f64::INFINITY, f64::min);
-                let high = values.iter().map(|v| v.2).fold(f64::NEG_INFINITY, f64::max);
-                let last_run = values.iter().map(|v| v.3).max().unwrap_or(0);
-                let status =
-                    statuses.get(&(last_run, scenario.clone(), method.clone())).cloned().unwrap_or_default();
-                Point { commit, value, low, high, sigma: measure.sigma(value, low, high), status }
-            })
-            .collect();
-        let observations: Vec<Observation> =
-            points.iter().map(|p| Observation { value: p.value, sigma: p.sigma }).collect();
-        let levels = steps::fit_levels(&observations, steps::default_penalty(points.len()));
-        let mut fitted = vec![0.0; points.len()];
-        for l in &levels {
-            fitted[l.start..l.end].iter_mut().for_each(|f| *f = l.value);
-        }
-        let steps = steps::detect_steps(&observations)
-            .into_iter()
-            .map(|s| {
-                let (from, to) = (points[s.at - 1].commit, points[s.at].commit);
-                let adjacent = commits[to].follows(&commits[from]);
-                AttributedStep {
-                    from,
-                    to,
-                    before: s.before,
-                    after: s.after,
-                    relative: s.relative_change(),
-                    made_by: adjacent.then_some(to),
-                }
-            })
-            .collect();
-        timelines.push(Timeline { series, scenario, method, measure, points, fitted, steps });
+    Ok(grouped)
+}
+
+/// The timeline of `case` from its values at each point (`by_commit`): the points (`statuses`
+/// gives each its case's status in its last run), their fitted levels, and the steps between
+/// them, each attributed where the two `commits` on either side are parent and child.
+fn timeline(
+    case: CaseMeasure,
+    by_commit: BTreeMap<usize, Vec<StoredPoint>>,
+    statuses: &BTreeMap<(i64, String, String), String>,
+    commits: &[CommitInfo],
+) -> Timeline {
+    let (series, scenario, method, measure) = case;
+    let status_in =
+        |run: i64| statuses.get(&(run, scenario.clone(), method.clone())).cloned().unwrap_or_default();
+    let points: Vec<Point> =
+        by_commit.into_iter().map(|(commit, values)| point(commit, values, measure, &status_in)).collect();
+    let observations: Vec<Observation> =
+        points.iter().map(|p| Observation { value: p.value, sigma: p.sigma }).collect();
+    let fitted = fitted_levels(&observations);
+    let steps = attributed_steps(&observations, &points, commits);
+    Timeline { series, scenario, method, measure, points, fitted, steps }
+}
+
+/// The point at `commit` of `measure` from its stored `values` there (several runs: the median
+/// value, the widest spread), weighed with the measure's noise; its status is its last run's, as
+/// `status_in(run)` tells.
+fn point(
+    commit: usize,
+    mut values: Vec<StoredPoint>,
+    measure: Measure,
+    status_in: &dyn Fn(i64) -> String,
+) -> Point {
+    values.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let value = values[values.len() / 2].0;
+    let low = values.iter().map(|v| v.1).fold(f64::INFINITY, f64::min);
+    let high = values.iter().map(|v| v.2).fold(f64::NEG_INFINITY, f64::max);
+    let last_run = values.iter().map(|v| v.3).max().unwrap_or(0);
+    Point { commit, value, low, high, sigma: measure.sigma(value, low, high), status: status_in(last_run) }
+}
+
+/// The fitted level of each of `observations` ([`steps::fit_levels`] with its default penalty).
+fn fitted_levels(observations: &[Observation]) -> Vec<f64> {
+    let levels = steps::fit_levels(observations, steps::default_penalty(observations.len()));
+    let mut fitted = vec![0.0; observations.len()];
+    for l in &levels {
+        fitted[l.start..l.end].iter_mut().for_each(|f| *f = l.value);
     }
-    let mut series: Vec<String> = runs.iter().map(|r| r.series.clone()).collect();
-    series.sort();
-    series.dedup();
-    let status_changes = status_changes(&timelines);
-    Ok(History { commits, method_change, series, timelines, status_changes })
+    fitted
+}
+
+/// The steps of `observations` (those of `points`), each between two of `commits`, attributed to
+/// the later one when it follows the earlier ([`CommitInfo::follows`]).
+fn attributed_steps(
+    observations: &[Observation],
+    points: &[Point],
+    commits: &[CommitInfo],
+) -> Vec<AttributedStep> {
+    steps::detect_steps(observations)
+        .into_iter()
+        .map(|s| {
+            let (from, to) = (points[s.at - 1].commit, points[s.at].commit);
+            let adjacent = commits[to].follows(&commits[from]);
+            AttributedStep {
+                from,
+                to,
+                before: s.before,
+                after: s.after,
+                relative: s.relative_change(),
+                made_by: adjacent.then_some(to),
+            }
+        })
+        .collect()
 }
 
 /// Where a case's verdict kind changed between consecutive points (read off its iterations

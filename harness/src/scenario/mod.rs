@@ -454,7 +454,9 @@ pub fn load_specs(dir: &Path) -> Result<Vec<ScenarioSpec>, HarnessError> {
 /// Read and check one scenario file.
 pub fn load_spec(path: &Path) -> Result<ScenarioSpec, HarnessError> {
     let config = |message: String| HarnessError::Config { path: path.to_path_buf(), message };
-    let table = read_extended(path, 0)?;
+    // Keys sorted, as toml's map had them before the workspace enabled `preserve_order`: of several
+    // faults in a file, serde names the first it meets.
+    let table = crate::config::in_key_order(read_extended(path, 0)?);
     let mut spec: ScenarioSpec = table.try_into().map_err(|e: toml::de::Error| config(e.to_string()))?;
     spec.path = path.to_path_buf();
     let builtin = spec.survey.is_some() || spec.procedural.is_some();
@@ -554,6 +556,49 @@ struct InitialEdit {
     regions: Vec<HandleRegion>,
     motions: Vec<Motion>,
     roles: Vec<Role>,
+}
+
+/// A survey mesh or procedural look-alike: the mesh, its topology, its survey selection and
+/// transform (the survey edit), and where it came from (`mesh_source`).
+struct BuiltinMesh {
+    mesh: TriMesh,
+    topology: Topology,
+    selection: Vec<VertexStatus>,
+    transform: AffineTransform,
+    mesh_source: String,
+}
+
+/// A mesh file as a scenario uses it (read, repaired, refined), the notes of what was done to it,
+/// the collection's member it is (with what repair changed) and the record of a repair.
+struct FileMesh {
+    input: TriMesh,
+    notes: Vec<String>,
+    member: Option<Member>,
+    repaired: Option<Repaired>,
+}
+
+/// The notes on the mesh file `path` once its unreferenced vertices are dropped (`mesh`, `map`):
+/// how many were dropped, and how many of the others are exact duplicates.
+fn cleaning_notes(path: &Path, mesh: &TriMesh, map: &meshes::clean::VertexMap) -> Vec<String> {
+    let mut notes = Vec::new();
+    let dropped = map.dropped();
+    if !dropped.is_empty() {
+        notes.push(format!(
+            "{}: {} unreferenced vertices dropped (e.g. vertex {}); results are written in the file's vertex order",
+            path.display(),
+            dropped.len(),
+            dropped[0]
+        ));
+    }
+    let duplicates = meshes::clean::exact_duplicate_vertices(mesh.positions());
+    if let Some((a, b)) = duplicates.first() {
+        notes.push(format!(
+            "{}: {} exact duplicate vertices (e.g. mesh vertices {a} and {b} at the same position); they are kept as distinct vertices",
+            path.display(),
+            duplicates.len()
+        ));
+    }
+    notes
 }
 
 /// The per-vertex files of a mesh file with `n_input` vertices, read with the mesh crate's readers.
@@ -656,91 +701,18 @@ impl ScenarioSpec {
 
     /// A survey mesh or procedural look-alike, with the survey edit or the scenario's regions.
     fn load_builtin(&self, source: &DataSource, check: SizeCheck) -> Result<LoadedScenario, HarnessError> {
-        let fail = |message: String| HarnessError::Scenario {
-            scenario: self.name.clone(),
-            file: Some(self.path.clone()),
-            message,
-        };
-        let (mesh, topology, selection, transform, mesh_source) = match (
-            source,
-            &self.survey,
-            &self.procedural,
-        ) {
-            (DataSource::Survey(dir), Some(stem), _) => {
-                let mesh_path = dir.join(format!("{stem}.off"));
-                if let Some((v, f)) = meshes::io::header_counts(&mesh_path) {
-                    check(&SizeRequest {
-                        spec: self,
-                        scenario: &self.name,
-                        key: format!("survey = \"{stem}\""),
-                        mesh: format!(
-                            "{} ({} vertices)",
-                            mesh_path.display(),
-                            crate::memory::count(v as f64)
-                        ),
-                        vertices: v as f64,
-                        faces: f as f64,
-                    })?;
-                }
-                for extension in ["off", "sel", "def"] {
-                    self.files_read.push(dir.join(format!("{stem}.{extension}")));
-                }
-                let mesh = meshes::io::read_mesh(&mesh_path)?;
-                mesh.check_nondegenerate().map_err(|e| e.in_file(&mesh_path))?;
-                let topology = Topology::new(&mesh).map_err(|e| e.in_file(&mesh_path))?;
-                let selection =
-                    meshes::io::read_selection(dir.join(format!("{stem}.sel")), mesh.n_vertices())?;
-                let transform = meshes::io::read_transform(dir.join(format!("{stem}.def")))?;
-                (mesh, topology, selection, transform, "survey".to_string())
-            }
-            (_, _, Some(p)) => {
-                let kind: ShapeKind = p.shape.parse().map_err(|e| fail(format!("{e}")))?;
-                let target = p.vertices.unwrap_or_else(|| shapes::default_vertex_count(kind));
-                let vertices = p.vertices.map(|n| format!(", vertices = {n}")).unwrap_or_default();
-                check(&SizeRequest {
-                    spec: self,
-                    scenario: &self.name,
-                    key: format!("procedural = {{ shape = \"{}\"{vertices} }}", p.shape),
-                    mesh: format!(
-                        "the procedural {} of {} vertices",
-                        p.shape,
-                        crate::memory::count(target as f64)
-                    ),
-                    // A closed triangle mesh has about two faces per vertex.
-                    vertices: target as f64,
-                    faces: 2.0 * target as f64,
-                })?;
-                let shape = shapes::generate(kind, target)?;
-                shape.mesh.check_nondegenerate()?;
-                let topology = Topology::new(&shape.mesh)?;
-                (shape.mesh, topology, shape.selection, shape.transform, "procedural look-alike".to_string())
-            }
+        let fail = |message: String| self.scenario_error(message);
+        let builtin = match (source, &self.survey, &self.procedural) {
+            (DataSource::Survey(dir), Some(stem), _) => self.survey_mesh(dir, stem, check)?,
+            (_, _, Some(p)) => self.procedural_mesh(p, check)?,
             (DataSource::Procedural, Some(_), None) => return Err(fail(
                 "needs the survey data (--survey-dir or DEFORM_SURVEY_DIR) and has no `procedural` fallback"
                     .into(),
             )),
             (_, None, None) => return Err(fail("has neither `survey` nor `procedural`".into())),
         };
-        let steps = if self.regions.is_empty() {
-            if self.frame != Frame::Bbox {
-                return Err(fail(
-                    "`frame` applies to [[regions]]; the survey edit is in the mesh's own coordinates".into(),
-                ));
-            }
-            let (regions, motions) =
-                survey_regions(&selection, &transform).map_err(|e| fail(e.to_string()))?;
-            let roles =
-                regions.iter().map(|r| if r.name == "fixed" { Role::Fixed } else { Role::Handle }).collect();
-            self.resolve_steps(&mesh, &InitialEdit { regions, motions, roles }).map_err(fail)?
-        } else {
-            let input = InputIndex::identity(mesh.n_vertices());
-            let files = InputFiles { n_input: mesh.n_vertices() };
-            self.steps_in_frame(&mesh, |m| {
-                let initial = self.regions_edit(m, &input, &self.paths(None), &files)?;
-                self.resolve_steps(m, &initial)
-            })
-            .map_err(fail)?
-        };
+        let BuiltinMesh { mesh, topology, selection, transform, mesh_source } = builtin;
+        let steps = self.builtin_steps(&mesh, &selection, &transform).map_err(fail)?;
         check_components(&mesh, &steps, None).map_err(fail)?;
         Ok(LoadedScenario {
             spec: self.clone(),
@@ -752,6 +724,91 @@ impl ScenarioSpec {
             notes: Vec::new(),
             member: None,
             repaired: None,
+        })
+    }
+
+    /// The error `message` of this scenario, naming it and its file.
+    fn scenario_error(&self, message: String) -> HarnessError {
+        HarnessError::Scenario { scenario: self.name.clone(), file: Some(self.path.clone()), message }
+    }
+
+    /// The survey's mesh `stem` in `dir` (`<stem>.off`) with its selection (`.sel`) and transform
+    /// (`.def`), its size given to `check` first when the header tells it.
+    fn survey_mesh(&self, dir: &Path, stem: &str, check: SizeCheck) -> Result<BuiltinMesh, HarnessError> {
+        let mesh_path = dir.join(format!("{stem}.off"));
+        if let Some((v, f)) = meshes::io::header_counts(&mesh_path) {
+            check(&SizeRequest {
+                spec: self,
+                scenario: &self.name,
+                key: format!("survey = \"{stem}\""),
+                mesh: format!("{} ({} vertices)", mesh_path.display(), crate::memory::count(v as f64)),
+                vertices: v as f64,
+                faces: f as f64,
+            })?;
+        }
+        for extension in ["off", "sel", "def"] {
+            self.files_read.push(dir.join(format!("{stem}.{extension}")));
+        }
+        let mesh = meshes::io::read_mesh(&mesh_path)?;
+        mesh.check_nondegenerate().map_err(|e| e.in_file(&mesh_path))?;
+        let topology = Topology::new(&mesh).map_err(|e| e.in_file(&mesh_path))?;
+        let selection = meshes::io::read_selection(dir.join(format!("{stem}.sel")), mesh.n_vertices())?;
+        let transform = meshes::io::read_transform(dir.join(format!("{stem}.def")))?;
+        Ok(BuiltinMesh { mesh, topology, selection, transform, mesh_source: "survey".to_string() })
+    }
+
+    /// The procedural look-alike `p` asks for, with its survey-like selection and transform, its
+    /// size given to `check` before it is generated.
+    fn procedural_mesh(&self, p: &ProceduralSpec, check: SizeCheck) -> Result<BuiltinMesh, HarnessError> {
+        let kind: ShapeKind = p.shape.parse().map_err(|e| self.scenario_error(format!("{e}")))?;
+        let target = p.vertices.unwrap_or_else(|| shapes::default_vertex_count(kind));
+        let vertices = p.vertices.map(|n| format!(", vertices = {n}")).unwrap_or_default();
+        check(&SizeRequest {
+            spec: self,
+            scenario: &self.name,
+            key: format!("procedural = {{ shape = \"{}\"{vertices} }}", p.shape),
+            mesh: format!("the procedural {} of {} vertices", p.shape, crate::memory::count(target as f64)),
+            // A closed triangle mesh has about two faces per vertex.
+            vertices: target as f64,
+            faces: 2.0 * target as f64,
+        })?;
+        let shape = shapes::generate(kind, target)?;
+        shape.mesh.check_nondegenerate()?;
+        let topology = Topology::new(&shape.mesh)?;
+        Ok(BuiltinMesh {
+            mesh: shape.mesh,
+            topology,
+            selection: shape.selection,
+            transform: shape.transform,
+            mesh_source: "procedural look-alike".to_string(),
+        })
+    }
+
+    /// The steps on a survey or procedural `mesh`: the survey edit (its `selection` and
+    /// `transform`) when the scenario has no `[[regions]]`, else its regions in its frame. `Err`:
+    /// the message.
+    fn builtin_steps(
+        &self,
+        mesh: &TriMesh,
+        selection: &[VertexStatus],
+        transform: &AffineTransform,
+    ) -> Result<Vec<LoadedStep>, String> {
+        if self.regions.is_empty() {
+            if self.frame != Frame::Bbox {
+                return Err(
+                    "`frame` applies to [[regions]]; the survey edit is in the mesh's own coordinates".into(),
+                );
+            }
+            let (regions, motions) = survey_regions(selection, transform).map_err(|e| e.to_string())?;
+            let roles =
+                regions.iter().map(|r| if r.name == "fixed" { Role::Fixed } else { Role::Handle }).collect();
+            return self.resolve_steps(mesh, &InitialEdit { regions, motions, roles });
+        }
+        let input = InputIndex::identity(mesh.n_vertices());
+        let files = InputFiles { n_input: mesh.n_vertices() };
+        self.steps_in_frame(mesh, |m| {
+            let initial = self.regions_edit(m, &input, &self.paths(None), &files)?;
+            self.resolve_steps(m, &initial)
         })
     }
 
@@ -769,91 +826,18 @@ impl ScenarioSpec {
             file: Some(self.path.clone()),
             message,
         };
-        // The size before anything is read when the header tells it, and before refining.
-        let request = |v: usize, f: usize, told: &str| {
-            let (vertices, faces) = crate::memory::refined_size(v as f64, f as f64, self.refine);
-            let (key, mesh) = if self.refine > 0 {
-                (
-                    format!("refine = {}", self.refine),
-                    format!(
-                        "{} ({v} vertices, {f} faces{told}) refined {} times: {} vertices, {} faces",
-                        path.display(),
-                        self.refine,
-                        crate::memory::count(vertices),
-                        crate::memory::count(faces)
-                    ),
-                )
-            } else {
-                let key = match (&self.mesh, &self.meshes) {
-                    (Some(m), _) => format!("mesh = \"{m}\""),
-                    (_, Some(g)) => format!("meshes = \"{g}\""),
-                    _ => "[manifest]".to_string(),
-                };
-                (key, format!("{} ({} vertices{told})", path.display(), crate::memory::count(vertices)))
-            };
-            SizeRequest { spec: self, scenario: name, key, mesh, vertices, faces }
-        };
-        if let Some((v, f)) = meshes::io::header_counts(path) {
-            check(&request(v, f, " by its header"))?;
-        }
-        let mut input = meshes::io::read_mesh(path)?;
-        let mut notes = Vec::new();
-        let mut member = member;
-        let mut repaired_by = None;
-        if self.repair {
-            // Results are then written with the repaired faces, in the file's vertex order.
-            let (repaired, log) = meshes::repair::repair(&input).map_err(|e| e.in_file(path))?;
-            if !log.is_empty() {
-                notes.push(format!("{}: repaired: {}", path.display(), log.summary()));
-                if let Some(m) = &mut member {
-                    m.repaired = Some(log.summary());
-                }
-                repaired_by = Some(Repaired { file: path.to_path_buf(), changes: log.summary() });
-            }
-            input = repaired;
-        }
-        check(&request(input.n_vertices(), input.n_faces(), ""))?;
-        if self.refine > 0 {
-            input = self.refined(input, path, &mut notes)?;
-        }
+        let FileMesh { input, mut notes, member, repaired } =
+            self.read_mesh_file(path, name, member, check)?;
         let (mesh, map) = meshes::clean::drop_unreferenced(&input);
-        let dropped = map.dropped();
-        if !dropped.is_empty() {
-            notes.push(format!(
-                "{}: {} unreferenced vertices dropped (e.g. vertex {}); results are written in the file's vertex order",
-                path.display(),
-                dropped.len(),
-                dropped[0]
-            ));
-        }
-        let duplicates = meshes::clean::exact_duplicate_vertices(mesh.positions());
-        if let Some((a, b)) = duplicates.first() {
-            notes.push(format!(
-                "{}: {} exact duplicate vertices (e.g. mesh vertices {a} and {b} at the same position); they are kept as distinct vertices",
-                path.display(),
-                duplicates.len()
-            ));
-        }
+        notes.extend(cleaning_notes(path, &mesh, &map));
         mesh.check_nondegenerate().map_err(|e| e.in_file(path))?;
         let topology = Topology::new(&mesh).map_err(|e| e.in_file(path))?;
-        let mut kept_of_input = vec![None; input.n_vertices()];
-        for (i, &v) in map.kept().iter().enumerate() {
-            kept_of_input[v as usize] = Some(i as u32);
-        }
-        let index = InputIndex { kept_of_input };
-        let files = InputFiles { n_input: input.n_vertices() };
         let mut spec = self.clone();
         spec.name = name.to_string();
-        let paths = self.paths(stem);
-        let steps = spec
-            .steps_in_frame(&mesh, |m| {
-                let initial = spec.regions_edit(m, &index, &paths, &files)?;
-                spec.resolve_steps(m, &initial)
-            })
-            .map_err(fail)?;
+        let steps = spec.file_steps(&mesh, &input, &map, &self.paths(stem)).map_err(fail)?;
         let kept = map.kept().to_vec();
         check_components(&mesh, &steps, Some(&kept)).map_err(|e| fail(format!("{}: {e}", path.display())))?;
-        let input = (!dropped.is_empty()).then(|| InputMesh { mesh: input, kept });
+        let input = (!map.dropped().is_empty()).then(|| InputMesh { mesh: input, kept });
         Ok(LoadedScenario {
             spec,
             mesh_source: FILE_SOURCE.to_string(),
@@ -863,7 +847,110 @@ impl ScenarioSpec {
             input,
             notes,
             member,
-            repaired: repaired_by,
+            repaired,
+        })
+    }
+
+    /// The mesh file `path` as the scenario `name` uses it: read, repaired and refined as the
+    /// scenario says, its size given to `check` before it is read (when its header tells it) and
+    /// before it is refined; with the notes of what was done to it, and `member` (a collection's
+    /// mesh) with what repair changed.
+    fn read_mesh_file(
+        &self,
+        path: &Path,
+        name: &str,
+        mut member: Option<Member>,
+        check: SizeCheck,
+    ) -> Result<FileMesh, HarnessError> {
+        if let Some((v, f)) = meshes::io::header_counts(path) {
+            check(&self.file_size_request(path, name, (v, f), " by its header"))?;
+        }
+        let mut notes = Vec::new();
+        let (mut input, repaired) =
+            self.repaired(meshes::io::read_mesh(path)?, path, &mut notes, &mut member)?;
+        check(&self.file_size_request(path, name, (input.n_vertices(), input.n_faces()), ""))?;
+        if self.refine > 0 {
+            input = self.refined(input, path, &mut notes)?;
+        }
+        Ok(FileMesh { input, notes, member, repaired })
+    }
+
+    /// What the run's memory check is told of the mesh file `path` of `counts` (vertices, faces;
+    /// `told` says where they come from) as the scenario `name`: refined when the scenario says so.
+    fn file_size_request<'a>(
+        &'a self,
+        path: &Path,
+        name: &'a str,
+        (v, f): (usize, usize),
+        told: &str,
+    ) -> SizeRequest<'a> {
+        let (vertices, faces) = crate::memory::refined_size(v as f64, f as f64, self.refine);
+        let (key, mesh) = if self.refine > 0 {
+            (
+                format!("refine = {}", self.refine),
+                format!(
+                    "{} ({v} vertices, {f} faces{told}) refined {} times: {} vertices, {} faces",
+                    path.display(),
+                    self.refine,
+                    crate::memory::count(vertices),
+                    crate::memory::count(faces)
+                ),
+            )
+        } else {
+            let key = match (&self.mesh, &self.meshes) {
+                (Some(m), _) => format!("mesh = \"{m}\""),
+                (_, Some(g)) => format!("meshes = \"{g}\""),
+                _ => "[manifest]".to_string(),
+            };
+            (key, format!("{} ({} vertices{told})", path.display(), crate::memory::count(vertices)))
+        };
+        SizeRequest { spec: self, scenario: name, key, mesh, vertices, faces }
+    }
+
+    /// `input` (read from `path`) repaired when the scenario says `repair = true`
+    /// ([`meshes::repair`]); when that changed something, a note of it in `notes` and `member`, and
+    /// the [`Repaired`] record.
+    fn repaired(
+        &self,
+        input: TriMesh,
+        path: &Path,
+        notes: &mut Vec<String>,
+        member: &mut Option<Member>,
+    ) -> Result<(TriMesh, Option<Repaired>), HarnessError> {
+        if !self.repair {
+            return Ok((input, None));
+        }
+        // Results are then written with the repaired faces, in the file's vertex order.
+        let (repaired, log) = meshes::repair::repair(&input).map_err(|e| e.in_file(path))?;
+        if log.is_empty() {
+            return Ok((repaired, None));
+        }
+        notes.push(format!("{}: repaired: {}", path.display(), log.summary()));
+        if let Some(m) = member {
+            m.repaired = Some(log.summary());
+        }
+        Ok((repaired, Some(Repaired { file: path.to_path_buf(), changes: log.summary() })))
+    }
+
+    /// The steps on `mesh`, the mesh file `input` without its unreferenced vertices (`map`): the
+    /// scenario's regions in its frame, those chosen by file through `map`, files found from
+    /// `paths`. `Err`: the message.
+    fn file_steps(
+        &self,
+        mesh: &TriMesh,
+        input: &TriMesh,
+        map: &meshes::clean::VertexMap,
+        paths: &PathContext,
+    ) -> Result<Vec<LoadedStep>, String> {
+        let mut kept_of_input = vec![None; input.n_vertices()];
+        for (i, &v) in map.kept().iter().enumerate() {
+            kept_of_input[v as usize] = Some(i as u32);
+        }
+        let index = InputIndex { kept_of_input };
+        let files = InputFiles { n_input: input.n_vertices() };
+        self.steps_in_frame(mesh, |m| {
+            let initial = self.regions_edit(m, &index, paths, &files)?;
+            self.resolve_steps(m, &initial)
         })
     }
 

@@ -224,105 +224,190 @@ impl Selection {
         paths: &PathContext,
         files: &dyn SelectionFiles,
     ) -> Result<Vec<u32>, String> {
-        let n_input = input.n_input();
-        let (lo, hi) = meshes::geometry::bbox(positions);
-        let diagonal = norm(sub(hi, lo));
-        let to_box = |p: [f64; 3]| -> [f64; 3] {
-            std::array::from_fn(|k| if hi[k] > lo[k] { (p[k] - lo[k]) / (hi[k] - lo[k]) } else { 0.5 })
-        };
-        let from_box = |c: [f64; 3]| -> [f64; 3] { std::array::from_fn(|k| lo[k] + c[k] * (hi[k] - lo[k])) };
-        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-        // The mesh vertices at which `inside` holds, or the error `empty` says.
-        let within = |inside: &dyn Fn([f64; 3]) -> bool, empty: &dyn Fn() -> String| {
-            let picked: Vec<u32> =
-                (0..positions.len() as u32).filter(|&v| inside(positions[v as usize])).collect();
-            if picked.is_empty() {
-                Err(empty())
-            } else {
-                Ok(picked)
-            }
-        };
-        let picked: Vec<u32> = match self {
-            Selection::Sel { file, status } => {
-                let path = paths.resolve_existing("select.sel.file", file)?;
-                let codes = files.sel(&path)?;
-                let picked =
-                    (0..n_input as u32).filter(|&v| codes[v as usize] == *status).collect::<Vec<_>>();
-                if picked.is_empty() {
-                    return Err(format!("{}: no vertex has status {status}", path.display()));
-                }
-                picked
-            }
-            Selection::Dmat { file, id, form } => {
-                let id = match (form, id) {
-                    (DmatForm::RegionIds, Some(id)) => *id,
-                    (DmatForm::RegionIds, None) => {
-                        return Err(format!(
-                            "select.dmat = {{ file = \"{file}\" }}: give `id = N` (the vertices whose region id is N in a \
-                             per-vertex .dmat) or `form = \"indices\"` (the file lists vertex indices)"
-                        ))
-                    }
-                    (DmatForm::Indices, Some(_)) => {
-                        return Err(format!(
-                            "select.dmat = {{ file = \"{file}\", form = \"indices\" }}: an index list takes no `id` \
-                             (`id` picks a region of a per-vertex .dmat of region ids)"
-                        ))
-                    }
-                    (DmatForm::Indices, None) => {
-                        let path = paths.resolve_existing("select.dmat.file", file)?;
-                        return dmat_indices(&files.dmat(&path)?, n_input, &path);
-                    }
-                };
-                let path = paths.resolve_existing("select.dmat.file", file)?;
-                let ids = files.dmat(&path)?;
-                if ids.len() != n_input {
-                    return Err(wrong_length(&ids, n_input, &path, file));
-                }
-                let picked = (0..n_input as u32).filter(|&v| ids[v as usize] == id).collect::<Vec<_>>();
-                if picked.is_empty() {
-                    let mut present: Vec<i64> = ids.clone();
-                    present.sort();
-                    present.dedup();
-                    return Err(format!(
-                        "{}: no vertex has region id {id} (ids present: {present:?})",
-                        path.display()
-                    ));
-                }
-                picked
-            }
-            Selection::Vertices(list) => checked_ids(list.clone(), n_input, "select.vertices")?,
-            Selection::VertexFile(file) => {
-                let path = paths.resolve_existing("select.vertex_file", file)?;
-                checked_ids(files.index_list(&path)?, n_input, &path.display().to_string())?
-            }
-            Selection::Box { min, max } => {
-                if !(finite(min) && finite(max)) || (0..3).any(|k| min[k] > max[k]) {
-                    return Err(format!("box: min {min:?} must be finite and <= max {max:?}"));
-                }
-                within(&|p| (0..3).all(|k| (min[k]..=max[k]).contains(&to_box(p)[k])), &|| {
-                    format!("box {min:?}..{max:?} (bbox coordinates, [0, 1] spans the mesh) holds no vertex")
-                })?
-            }
+        let source = FileSource { paths, files, n_input: input.n_input() };
+        match self {
+            Selection::Sel { file, status } => source.sel(file, *status),
+            Selection::Dmat { file, id, form } => source.dmat(file, *id, *form),
+            Selection::Vertices(list) => checked_ids(list.clone(), source.n_input, "select.vertices"),
+            Selection::VertexFile(file) => source.vertex_file(file),
+            Selection::Box { min, max } => BoxCoordinates::of(positions).inside_box(min, max),
             Selection::Sphere { center, radius } => {
-                if !(finite(center) && radius.is_finite() && *radius > 0.0) {
-                    return Err(format!("sphere: center {center:?} finite and radius {radius} > 0 needed"));
-                }
-                let c = from_box(*center);
-                within(&|p| norm(sub(p, c)) <= radius * diagonal, &|| {
-                    format!("sphere at {center:?} (bbox coordinates) with radius {radius} x diagonal holds no vertex")
-                })?
+                BoxCoordinates::of(positions).inside_sphere(center, *radius)
             }
             Selection::Slab { axis, from, to } => {
-                if !(from.is_finite() && to.is_finite() && from <= to) {
-                    return Err(format!("slab: from {from} must be finite and <= to {to}"));
-                }
-                within(&|p| (*from..=*to).contains(&to_box(p)[axis.index()]), &|| {
-                    format!("slab {axis:?} {from}..{to} (bbox coordinates, [0, 1] spans the mesh) holds no vertex")
-                })?
+                BoxCoordinates::of(positions).inside_slab(*axis, *from, *to)
             }
-        };
+        }
+    }
+}
+
+/// Where a selection by file reads: the scenario's paths, the per-vertex files, and the number of
+/// vertices of the mesh file (the input vertex ids the files give are below it).
+struct FileSource<'a> {
+    paths: &'a PathContext,
+    files: &'a dyn SelectionFiles,
+    n_input: usize,
+}
+
+impl FileSource<'_> {
+    /// The input vertices of survey status `status` in the `.sel` file `file` (as written). `Err`:
+    /// the file is missing or unreadable, or no vertex has that status.
+    fn sel(&self, file: &str, status: u8) -> Result<Vec<u32>, String> {
+        let path = self.paths.resolve_existing("select.sel.file", file)?;
+        let codes = self.files.sel(&path)?;
+        let picked = (0..self.n_input as u32).filter(|&v| codes[v as usize] == status).collect::<Vec<_>>();
+        if picked.is_empty() {
+            return Err(format!("{}: no vertex has status {status}", path.display()));
+        }
         Ok(picked)
     }
+
+    /// The input vertices the `.dmat` file `file` (as written) selects, read as `form` says: of
+    /// region id `id`, or the indices it lists. `Err`: an `id` the form does not take or lacks, or
+    /// what is wrong with the file.
+    fn dmat(&self, file: &str, id: Option<i64>, form: DmatForm) -> Result<Vec<u32>, String> {
+        let id = match (form, id) {
+            (DmatForm::RegionIds, Some(id)) => id,
+            (DmatForm::RegionIds, None) => {
+                return Err(format!(
+                    "select.dmat = {{ file = \"{file}\" }}: give `id = N` (the vertices whose region id is N in a \
+                     per-vertex .dmat) or `form = \"indices\"` (the file lists vertex indices)"
+                ))
+            }
+            (DmatForm::Indices, Some(_)) => {
+                return Err(format!(
+                    "select.dmat = {{ file = \"{file}\", form = \"indices\" }}: an index list takes no `id` \
+                     (`id` picks a region of a per-vertex .dmat of region ids)"
+                ))
+            }
+            (DmatForm::Indices, None) => {
+                let path = self.paths.resolve_existing("select.dmat.file", file)?;
+                return dmat_indices(&self.files.dmat(&path)?, self.n_input, &path);
+            }
+        };
+        self.dmat_region(file, id)
+    }
+
+    /// The input vertices of region id `id` in the per-vertex `.dmat` file `file` (as written).
+    /// `Err`: the file is missing or unreadable, does not hold one id per vertex, or no vertex has
+    /// that id.
+    fn dmat_region(&self, file: &str, id: i64) -> Result<Vec<u32>, String> {
+        let path = self.paths.resolve_existing("select.dmat.file", file)?;
+        let ids = self.files.dmat(&path)?;
+        if ids.len() != self.n_input {
+            return Err(wrong_length(&ids, self.n_input, &path, file));
+        }
+        let picked = (0..self.n_input as u32).filter(|&v| ids[v as usize] == id).collect::<Vec<_>>();
+        if picked.is_empty() {
+            let mut present: Vec<i64> = ids.clone();
+            present.sort();
+            present.dedup();
+            return Err(format!(
+                "{}: no vertex has region id {id} (ids present: {present:?})",
+                path.display()
+            ));
+        }
+        Ok(picked)
+    }
+
+    /// The input vertices listed in the text file `file` (as written), sorted and deduplicated.
+    fn vertex_file(&self, file: &str) -> Result<Vec<u32>, String> {
+        let path = self.paths.resolve_existing("select.vertex_file", file)?;
+        checked_ids(self.files.index_list(&path)?, self.n_input, &path.display().to_string())
+    }
+}
+
+/// A mesh's vertices and its bounding box, for the selections by shape: in box coordinates
+/// `[0, 1]^3` spans the box, lengths are in diagonals.
+struct BoxCoordinates<'a> {
+    positions: &'a [[f64; 3]],
+    lo: [f64; 3],
+    hi: [f64; 3],
+    diagonal: f64,
+}
+
+impl<'a> BoxCoordinates<'a> {
+    /// The box coordinates of the `#V x 3` mesh `positions`.
+    fn of(positions: &'a [[f64; 3]]) -> Self {
+        let (lo, hi) = meshes::geometry::bbox(positions);
+        Self { positions, lo, hi, diagonal: norm(sub(hi, lo)) }
+    }
+
+    /// The point `p` in box coordinates (0.5 along an axis the box is flat in).
+    fn to_box(&self, p: [f64; 3]) -> [f64; 3] {
+        let (lo, hi) = (self.lo, self.hi);
+        std::array::from_fn(|k| if hi[k] > lo[k] { (p[k] - lo[k]) / (hi[k] - lo[k]) } else { 0.5 })
+    }
+
+    /// The point at box coordinates `c`.
+    fn from_box(&self, c: [f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|k| self.lo[k] + c[k] * (self.hi[k] - self.lo[k]))
+    }
+
+    /// The mesh vertices at which `inside` holds, or the error `empty` says.
+    fn within(
+        &self,
+        inside: impl Fn([f64; 3]) -> bool,
+        empty: impl FnOnce() -> String,
+    ) -> Result<Vec<u32>, String> {
+        let picked: Vec<u32> =
+            (0..self.positions.len() as u32).filter(|&v| inside(self.positions[v as usize])).collect();
+        if picked.is_empty() {
+            Err(empty())
+        } else {
+            Ok(picked)
+        }
+    }
+
+    /// The mesh vertices in the box `min..max` (box coordinates, inclusive). `Err`: a bad box, or
+    /// one that holds no vertex.
+    fn inside_box(&self, min: &[f64; 3], max: &[f64; 3]) -> Result<Vec<u32>, String> {
+        if !(finite(min) && finite(max)) || (0..3).any(|k| min[k] > max[k]) {
+            return Err(format!("box: min {min:?} must be finite and <= max {max:?}"));
+        }
+        self.within(
+            |p| (0..3).all(|k| (min[k]..=max[k]).contains(&self.to_box(p)[k])),
+            || format!("box {min:?}..{max:?} (bbox coordinates, [0, 1] spans the mesh) holds no vertex"),
+        )
+    }
+
+    /// The mesh vertices within `radius` diagonals of `center` (box coordinates). `Err`: a bad
+    /// sphere, or one that holds no vertex.
+    fn inside_sphere(&self, center: &[f64; 3], radius: f64) -> Result<Vec<u32>, String> {
+        if !(finite(center) && radius.is_finite() && radius > 0.0) {
+            return Err(format!("sphere: center {center:?} finite and radius {radius} > 0 needed"));
+        }
+        let c = self.from_box(*center);
+        self.within(
+            |p| norm(sub(p, c)) <= radius * self.diagonal,
+            || {
+                format!(
+                    "sphere at {center:?} (bbox coordinates) with radius {radius} x diagonal holds no vertex"
+                )
+            },
+        )
+    }
+
+    /// The mesh vertices whose `axis` box coordinate is in `from..=to`. `Err`: a bad slab, or one
+    /// that holds no vertex.
+    fn inside_slab(&self, axis: Axis, from: f64, to: f64) -> Result<Vec<u32>, String> {
+        if !(from.is_finite() && to.is_finite() && from <= to) {
+            return Err(format!("slab: from {from} must be finite and <= to {to}"));
+        }
+        self.within(
+            |p| (from..=to).contains(&self.to_box(p)[axis.index()]),
+            || {
+                format!(
+                    "slab {axis:?} {from}..{to} (bbox coordinates, [0, 1] spans the mesh) holds no vertex"
+                )
+            },
+        )
+    }
+}
+
+/// Whether every value of `v` is finite.
+fn finite(v: &[f64]) -> bool {
+    v.iter().all(|x| x.is_finite())
 }
 
 /// The vertices of the index-list `.dmat` `path` (`values`, of a mesh file of `n` vertices), sorted
