@@ -22,6 +22,7 @@ use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::document::{Image, ImageGroup};
 use crate::error::HarnessError;
 use crate::metrics::{MetricSpec, METRICS};
 use crate::record::CaseResult;
@@ -71,13 +72,41 @@ fn method_color(method: &str, cases: &[&CaseResult]) -> RGBColor {
     PALETTE[index % PALETTE.len()]
 }
 
-/// Write every plot of `results` under `dir/plots/`; returns the paths written relative to `dir`
-/// (PNG and SVG of each plot).
-pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, HarnessError> {
+/// Write every plot of `results` under `dir/plots/`, each as PNG and SVG; returns the PNGs, their
+/// paths relative to `dir`, in the page's groups.
+pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<Image>, HarnessError> {
     crate::report::fonts::register_sans_serif()?;
     let plot_dir = dir.join("plots");
     std::fs::create_dir_all(&plot_dir).map_err(|error| HarnessError::Io { path: plot_dir.clone(), error })?;
-    let mut written = Vec::new();
+    let mut written = scenario_plots(dir, results)?;
+    let sweeps: Vec<&CaseResult> =
+        results.iter().filter(|r| r.scenario.contains("-sweep-") && !r.status.is_failed()).collect();
+    if !sweeps.is_empty() {
+        written.push(save(dir, "scaling", ImageGroup::Plot, &Plot::Scaling(&sweeps))?);
+    }
+    let handle_scenarios: Vec<&CaseResult> = results
+        .iter()
+        .filter(|r| r.scenario.ends_with("-handles") && methods::registry::table1_side(&r.method).is_some())
+        .collect();
+    if !handle_scenarios.is_empty() {
+        written.push(save(dir, "table1", ImageGroup::Plot, &Plot::Table1(&handle_scenarios))?);
+    }
+    let dataset = crate::report::dataset::dataset_cases(results);
+    if !dataset.is_empty() {
+        written.push(save(dir, "dataset-ecdf", ImageGroup::Dataset, &Plot::DatasetEcdf(&dataset))?);
+        written.push(save(dir, "dataset-cost", ImageGroup::Dataset, &Plot::DatasetCost(&dataset))?);
+    }
+    let series: Vec<&CaseResult> =
+        crate::report::size_series::series_cases(results).into_values().flatten().collect();
+    if !series.is_empty() {
+        written.push(save(dir, "size-series", ImageGroup::SizeSeries, &Plot::SizeSeries(&series))?);
+    }
+    Ok(written)
+}
+
+/// The plots of each test that is not a collection's (those are summed up by the dataset plots):
+/// errors, timings, convergence, and quality against time when it has sweep points.
+fn scenario_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<Image>, HarnessError> {
     let mut scenarios: Vec<&str> = Vec::new();
     for r in results {
         if !scenarios.contains(&r.scenario.as_str()) {
@@ -85,38 +114,21 @@ pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, H
         }
     }
     let swept = crate::report::quality_time::swept_scenarios(results);
-    // A collection's cases are summed up by the dataset plots below, not one plot set per mesh.
     scenarios.retain(|s| results.iter().any(|r| r.scenario == *s && r.member.is_none()));
+    let mut written = Vec::new();
     for scenario in scenarios {
         let cases: Vec<&CaseResult> = results.iter().filter(|r| r.scenario == scenario).collect();
-        written.extend(save(dir, &format!("{scenario}-errors"), &Plot::Errors(scenario, &cases))?);
-        written.extend(save(dir, &format!("{scenario}-timings"), &Plot::Timings(scenario, &cases))?);
-        written.extend(save(dir, &format!("{scenario}-convergence"), &Plot::Convergence(scenario, &cases))?);
+        let plot = |stem: &str, plot: Plot| save(dir, &format!("{scenario}-{stem}"), ImageGroup::Plot, &plot);
+        written.push(plot("errors", Plot::Errors(scenario, &cases))?);
+        written.push(plot("timings", Plot::Timings(scenario, &cases))?);
+        written.push(plot("convergence", Plot::Convergence(scenario, &cases))?);
         if swept.contains(&scenario) {
-            written.extend(save(dir, &format!("{scenario}-pareto"), &Plot::Pareto(scenario, &cases))?);
+            let group = ImageGroup::QualityTime(scenario.to_string());
+            let mut pareto =
+                save(dir, &format!("{scenario}-pareto"), group, &Plot::Pareto(scenario, &cases))?;
+            pareto.caption = format!("{scenario}: quality against time");
+            written.push(pareto);
         }
-    }
-    let sweeps: Vec<&CaseResult> =
-        results.iter().filter(|r| r.scenario.contains("-sweep-") && !r.status.is_failed()).collect();
-    if !sweeps.is_empty() {
-        written.extend(save(dir, "scaling", &Plot::Scaling(&sweeps))?);
-    }
-    let handle_scenarios: Vec<&CaseResult> = results
-        .iter()
-        .filter(|r| r.scenario.ends_with("-handles") && methods::registry::table1_side(&r.method).is_some())
-        .collect();
-    if !handle_scenarios.is_empty() {
-        written.extend(save(dir, "table1", &Plot::Table1(&handle_scenarios))?);
-    }
-    let dataset = crate::report::dataset::dataset_cases(results);
-    if !dataset.is_empty() {
-        written.extend(save(dir, "dataset-ecdf", &Plot::DatasetEcdf(&dataset))?);
-        written.extend(save(dir, "dataset-cost", &Plot::DatasetCost(&dataset))?);
-    }
-    let series: Vec<&CaseResult> =
-        crate::report::size_series::series_cases(results).into_values().flatten().collect();
-    if !series.is_empty() {
-        written.extend(save(dir, "size-series", &Plot::SizeSeries(&series))?);
     }
     Ok(written)
 }
@@ -168,8 +180,9 @@ impl Plot<'_> {
     }
 }
 
-/// Draw `plot` into `plots/<stem>.png` and `.svg` under `dir`; returns both relative paths.
-fn save(dir: &Path, stem: &str, plot: &Plot<'_>) -> Result<Vec<PathBuf>, HarnessError> {
+/// Draw `plot` into `plots/<stem>.png` and `.svg` under `dir`; returns the PNG in `group`, captioned
+/// by its stem.
+fn save(dir: &Path, stem: &str, group: ImageGroup, plot: &Plot<'_>) -> Result<Image, HarnessError> {
     let png = PathBuf::from("plots").join(format!("{stem}.png"));
     let svg = PathBuf::from("plots").join(format!("{stem}.svg"));
     let fail = |path: &Path, message: String| HarnessError::Report(format!("{}: {message}", path.display()));
@@ -193,7 +206,7 @@ fn save(dir: &Path, stem: &str, plot: &Plot<'_>) -> Result<Vec<PathBuf>, Harness
     }
     let final_svg = dir.join(&svg);
     meshes::io::atomic_write(&final_svg, |w| w.write_all(text.as_bytes()).map_err(meshes::MeshError::from))?;
-    Ok(vec![png, svg])
+    Ok(Image { group, path: png, caption: stem.to_string() })
 }
 
 fn err<E: std::fmt::Display>(e: E) -> String {

@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use crate::error::HarnessError;
 use crate::metrics::Metric;
 use crate::record::CaseResult;
+use crate::report::document::{Image, ImageGroup};
 use crate::scenario::{LoadedScenario, Role};
 
 use super::camera::{Camera, VIEW_FROM};
@@ -65,7 +66,8 @@ const FIGURES: &str = "figures";
 /// Write `figures/<scenario>-rest.png`, `figures/<scenario>-<method>.png`,
 /// `figures/<scenario>-<method>-heat.png`, `figures/<scenario>-<method>-area.png`, `figures/grid.png`,
 /// `figures/grid_heat.png`, `figures/grid_area.png` under `dir`;
-/// returns the paths written, relative to `dir` (for the HTML report).
+/// returns the images written, their paths relative to `dir`, in the page's groups (the worst-case
+/// sheets `figures/worst-<family>.png` of a dataset run too).
 ///
 /// `results` are the cases of the run (a result's `positions` are its final `#V x 3` shape on the
 /// rest connectivity of its scenario); `scenarios` give the rest meshes and the handle sets (the
@@ -79,7 +81,7 @@ pub fn write_figures(
     dir: &Path,
     results: &[CaseResult],
     scenarios: &[LoadedScenario],
-) -> Result<Vec<PathBuf>, HarnessError> {
+) -> Result<Vec<Image>, HarnessError> {
     crate::report::fonts::register_sans_serif()?;
     let columns = method_columns(results);
     let rows: Vec<Row> = scenarios
@@ -98,19 +100,51 @@ pub fn write_figures(
 
     let figures = dir.join(FIGURES);
     std::fs::create_dir_all(&figures).map_err(|error| HarnessError::Io { path: figures.clone(), error })?;
-    let mut files: Vec<(PathBuf, &RgbImage)> = Vec::new();
-    for (row, images) in rows.iter().zip(&rendered) {
+    let grids = grids(&rows, &rendered, &columns, results)
+        .map_err(|(name, e)| HarnessError::Report(format!("{}: {e}", figures.join(name).display())))?;
+    let mut files = single_renders(&rows, &rendered);
+    for (name, group, image) in &grids {
+        files.push((figure(Path::new(FIGURES).join(name), group.clone()), image));
+    }
+    write_pngs(dir, &files)?;
+    Ok(files.into_iter().map(|(image, _)| image).collect())
+}
+
+/// `path` in `group`, captioned by its stem.
+fn figure(path: PathBuf, group: ImageGroup) -> Image {
+    let caption = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    Image { group, path, caption }
+}
+
+/// Every row's rest render and each of its results' shaded, heat and area renders.
+fn single_renders<'a>(rows: &[Row], rendered: &'a [RenderedRow]) -> Vec<(Image, &'a RgbImage)> {
+    let mut files = Vec::new();
+    let mut add = |name: String, picture| {
+        files.push((figure(Path::new(FIGURES).join(name), ImageGroup::Render), picture))
+    };
+    for (row, images) in rows.iter().zip(rendered) {
         let stem = crate::stored_report::file_name(&row.scenario.spec.name);
-        files.push((Path::new(FIGURES).join(format!("{stem}-rest.png")), &images.rest));
+        add(format!("{stem}-rest.png"), &images.rest);
         for (case, cell) in row.cases.iter().zip(&images.cells) {
             if let (Some(case), Cell::Rendered { shaded, heat, area, .. }) = (case, cell) {
                 let stem = format!("{stem}-{}", crate::stored_report::file_name(&case.method));
-                files.push((Path::new(FIGURES).join(format!("{stem}.png")), shaded));
-                files.push((Path::new(FIGURES).join(format!("{stem}-heat.png")), heat));
-                files.push((Path::new(FIGURES).join(format!("{stem}-area.png")), area));
+                add(format!("{stem}.png"), shaded);
+                add(format!("{stem}-heat.png"), heat);
+                add(format!("{stem}-area.png"), area);
             }
         }
     }
+    files
+}
+
+/// The three grids (none above [`MAX_GRID_ROWS`] rows) and each family's worst-case sheet: file
+/// name, group and image; an error names the file.
+fn grids(
+    rows: &[Row],
+    rendered: &[RenderedRow],
+    columns: &[String],
+    results: &[CaseResult],
+) -> Result<Vec<(String, ImageGroup, RgbImage)>, (String, String)> {
     let grid_kinds: &[(Kind, &str)] = if rows.len() <= MAX_GRID_ROWS {
         &[(Kind::Shaded, "grid.png"), (Kind::Heat, "grid_heat.png"), (Kind::Area, "grid_area.png")]
     } else {
@@ -119,35 +153,37 @@ pub fn write_figures(
     let mut grids = grid_kinds
         .iter()
         .map(|&(kind, name)| {
-            grid_image(&rows, &rendered, &columns, kind)
-                .map(|image| (name.to_string(), image))
-                .map_err(|e| HarnessError::Report(format!("{}: {e}", figures.join(name).display())))
+            let image = grid_image(rows, rendered, columns, kind).map_err(|e| (name.to_string(), e))?;
+            Ok::<_, (String, String)>((name.to_string(), ImageGroup::Grid, image))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    for (family, (sheet_rows, sheet_rendered)) in worst_sheets(results, &rows, &rendered) {
+    for (family, (sheet_rows, sheet_rendered)) in worst_sheets(results, rows, rendered) {
         let name = format!("worst-{}.png", crate::stored_report::file_name(&family));
         let columns = ["result".to_string(), crate::record::REFERENCE_METHOD.to_string()];
         let image = grid_image(&sheet_rows, &sheet_rendered, &columns, Kind::Shaded)
-            .map_err(|e| HarnessError::Report(format!("{}: {e}", figures.join(&name).display())))?;
-        grids.push((name, image));
+            .map_err(|e| (name.clone(), e))?;
+        grids.push((name, ImageGroup::Dataset, image));
     }
-    for (name, image) in &grids {
-        files.push((Path::new(FIGURES).join(name), image));
-    }
+    Ok(grids)
+}
 
+/// Encode `files` as PNG (in parallel) and write each under `dir`, atomically.
+fn write_pngs(dir: &Path, files: &[(Image, &RgbImage)]) -> Result<(), HarnessError> {
     let encoded: Vec<Result<Vec<u8>, HarnessError>> = files
         .par_iter()
-        .map(|(path, image)| {
+        .map(|(file, image)| {
             image
                 .encode_png()
-                .map_err(|e| HarnessError::Report(format!("{}: PNG: {e}", dir.join(path).display())))
+                .map_err(|e| HarnessError::Report(format!("{}: PNG: {e}", dir.join(&file.path).display())))
         })
         .collect();
-    for ((path, _), bytes) in files.iter().zip(encoded) {
+    for ((file, _), bytes) in files.iter().zip(encoded) {
         let bytes = bytes?;
-        meshes::io::atomic_write(dir.join(path), |w| w.write_all(&bytes).map_err(meshes::MeshError::from))?;
+        meshes::io::atomic_write(dir.join(&file.path), |w| {
+            w.write_all(&bytes).map_err(meshes::MeshError::from)
+        })?;
     }
-    Ok(files.into_iter().map(|(path, _)| path).collect())
+    Ok(())
 }
 
 /// The most tests a run's grids draw: above it (a dataset run: hundreds of meshes x edits) the grids
@@ -672,6 +708,22 @@ mod tests {
         (results, scenarios)
     }
 
+    /// The paths of `images`, and that each is in the group its name says.
+    fn paths(images: Vec<Image>) -> Vec<PathBuf> {
+        for i in &images {
+            let name = i.path.file_name().unwrap().to_string_lossy();
+            let group = if name.starts_with("grid") {
+                ImageGroup::Grid
+            } else if name.starts_with("worst-") {
+                ImageGroup::Dataset
+            } else {
+                ImageGroup::Render
+            };
+            assert_eq!(i.group, group, "{name}");
+        }
+        images.into_iter().map(|i| i.path).collect()
+    }
+
     fn decode(path: &Path) -> image::RgbImage {
         image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgb8()
     }
@@ -680,7 +732,7 @@ mod tests {
     fn write_figures_writes_every_expected_file_deterministically() {
         let (results, scenarios) = inputs();
         let dirs = [tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap()];
-        let written = write_figures(dirs[0].path(), &results, &scenarios).unwrap();
+        let written = paths(write_figures(dirs[0].path(), &results, &scenarios).unwrap());
         let expected = [
             "tiny-rest.png",
             "tiny-laplacian.png",
@@ -719,7 +771,7 @@ mod tests {
         assert_eq!(heat.width(), grid.width());
         assert!(heat.height() > grid.height(), "the colour bar takes more room than the swatches");
 
-        assert_eq!(write_figures(dirs[1].path(), &results, &scenarios).unwrap(), written);
+        assert_eq!(paths(write_figures(dirs[1].path(), &results, &scenarios).unwrap()), written);
         for path in &written {
             let bytes = |d: &tempfile::TempDir| std::fs::read(d.path().join(path)).unwrap();
             assert!(bytes(&dirs[0]) == bytes(&dirs[1]), "{} differs between runs", path.display());
@@ -762,7 +814,7 @@ mod tests {
     #[test]
     fn no_results_still_give_every_grid() {
         let dir = tempfile::tempdir().unwrap();
-        let written = write_figures(dir.path(), &[], &[scenario("unused")]).unwrap();
+        let written = paths(write_figures(dir.path(), &[], &[scenario("unused")]).unwrap());
         assert_eq!(
             written,
             [
@@ -786,7 +838,7 @@ mod tests {
         with_runaway.push(case("tiny", "hirm", "suspect: leaves its frame", Some(far)));
         let dirs = [tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap()];
         write_figures(dirs[0].path(), &results, &scenarios).unwrap();
-        let written = write_figures(dirs[1].path(), &with_runaway, &scenarios).unwrap();
+        let written = paths(write_figures(dirs[1].path(), &with_runaway, &scenarios).unwrap());
         for name in ["tiny-rest.png", "tiny-laplacian.png", "tiny-laplacian-heat.png"] {
             let bytes = |d: &tempfile::TempDir| std::fs::read(d.path().join("figures").join(name)).unwrap();
             assert!(
