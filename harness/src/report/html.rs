@@ -223,6 +223,16 @@ fn cost_against_size(page: &mut String, context: &PageContext) {
 /// The results table: a row per case, every timing and measure, sortable and filtered by the page
 /// script; a row with a result mesh opens the 3D view.
 fn results_table(page: &mut String, context: &PageContext) {
+    results_header(page);
+    for r in context.results {
+        result_row(page, r, context.viewable);
+    }
+    page.push_str("</tbody></table></div>\n");
+}
+
+/// The section's heading, the filters' place and the table's header row: a column per timing and
+/// measure, each with the key the page script sorts and ranks by.
+fn results_header(page: &mut String) {
     page.push_str(
         "<h2 id=\"results\">Results</h2>\n<div id=\"filters\"></div>\n<div class=\"scroll\"><table id=\"results-table\">\n<thead><tr>\
          <th data-key=\"scenario\">scenario</th><th data-key=\"method\">method</th>\
@@ -246,92 +256,119 @@ fn results_table(page: &mut String, context: &PageContext) {
     page.push_str(
         "<th data-key=\"self_intersecting\">self-intersecting (open3d)</th></tr></thead>\n<tbody>\n",
     );
-    for r in context.results {
-        let (class, badge) = match r.origin {
-            Origin::BuiltIn => (
-                r.status.kind().to_string(),
-                r.reused_solve.as_ref().map_or(String::new(), |reused| {
-                    format!(
-                        "<span class=\"origin\" title=\"{}\">reuses {}</span>",
-                        escape(&format!(
-                            "its solve time includes {:.3} s of {}'s identical solve on this case, \
-                             taken from that case instead of computed again",
-                            reused.seconds, reused.from
-                        )),
-                        escape(&reused.from)
-                    )
-                }),
-            ),
-            other => (
-                format!("{} {}", r.status.kind(), other.label()),
+}
+
+/// One case's row: its data attributes for the filters and the 3D view, then its cells.
+fn result_row(page: &mut String, r: &CaseResult, viewable: &[String]) {
+    let (class, badge) = origin_mark(r);
+    let _ = write!(
+        page,
+        "<tr class=\"{class}\" data-scenario=\"{}\" data-method=\"{}\" data-status=\"{}\" data-source=\"{}\"{}{}>\
+         <td class=\"text\">{}</td><td class=\"text\">{}{badge}</td><td class=\"text status\">{}</td>\
+         <td data-v=\"{}\">{}</td><td data-v=\"{}\">{}</td><td>{}</td>",
+        escape(&r.scenario),
+        escape(&r.method),
+        r.status.kind(),
+        escape(&r.mesh_source),
+        member_attributes(r),
+        view_attributes(r, viewable),
+        escape(&r.scenario),
+        escape(&r.method),
+        escape(&r.status.to_string()),
+        r.vertices,
+        r.vertices,
+        r.iterations,
+        r.iterations,
+        if r.convergence_unknown {
+            "unknown"
+        } else if r.converged {
+            "yes"
+        } else {
+            "no"
+        },
+    );
+    page.push_str(&timing_cells(r));
+    page.push_str(&measure_cells(r));
+    let _ = writeln!(
+        page,
+        "<td>{}</td></tr>",
+        r.self_intersecting.map_or("not checked", |b| if b { "yes" } else { "no" }),
+    );
+}
+
+/// A row's class (its status, and its origin when not built in) and the mark beside its method: a
+/// peer's or an external program's origin, or the method whose identical solve it reuses.
+fn origin_mark(r: &CaseResult) -> (String, String) {
+    match r.origin {
+        Origin::BuiltIn => (
+            r.status.kind().to_string(),
+            r.reused_solve.as_ref().map_or(String::new(), |reused| {
                 format!(
-                    "<span class=\"origin\" title=\"{}\">{}</span>",
-                    escape(r.about.as_deref().unwrap_or("")),
-                    other.label()
-                ),
+                    "<span class=\"origin\" title=\"{}\">reuses {}</span>",
+                    escape(&format!(
+                        "its solve time includes {:.3} s of {}'s identical solve on this case, \
+                         taken from that case instead of computed again",
+                        reused.seconds, reused.from
+                    )),
+                    escape(&reused.from)
+                )
+            }),
+        ),
+        other => (
+            format!("{} {}", r.status.kind(), other.label()),
+            format!(
+                "<span class=\"origin\" title=\"{}\">{}</span>",
+                escape(r.about.as_deref().unwrap_or("")),
+                other.label()
             ),
-        };
+        ),
+    }
+}
+
+/// The attributes that open a case in the 3D view (its mesh files' stems), when it has them.
+fn view_attributes(r: &CaseResult, viewable: &[String]) -> String {
+    let stem = crate::stored_report::case_file_stem(&r.scenario, &r.method);
+    if viewable.contains(&stem) {
+        format!(
+            " data-view=\"{}\" data-rest=\"{}.rest\"",
+            escape(&stem),
+            escape(&crate::stored_report::file_name(&r.scenario))
+        )
+    } else {
+        String::new()
+    }
+}
+
+/// The timing cells (startup, precompute, bind, solve, total, iteration) and the peak memory.
+fn timing_cells(r: &CaseResult) -> String {
+    let spread = |phase: fn(&crate::record::TimingSpread) -> crate::record::Spread| {
+        r.spread.map(|s| (s.repetitions, phase(&s)))
+    };
+    [
+        timing(r.startup_s, spread(|s| s.startup_s), 3),
+        timing(r.precompute_s, spread(|s| s.precompute_s), 3),
+        timing(r.bind_s, spread(|s| s.bind_s), 4),
+        timing(r.solve_s, spread(|s| s.solve_s), 3),
+        timing(r.total_s, spread(|s| s.total_s), 3),
+        timing(r.median_iteration_ms, spread(|s| s.median_iteration_ms), 3),
+        format!("<td data-v=\"{}\">{}</td>", sort_value(r.peak_memory_mib), number(r.peak_memory_mib, 0)),
+    ]
+    .concat()
+}
+
+/// A cell per measure of [`METRICS`]: the value as the measure formats it, sorted by the full number.
+fn measure_cells(r: &CaseResult) -> String {
+    let mut cells = String::new();
+    for spec in &METRICS {
+        let value = r.quality.get(spec.metric);
         let _ = write!(
-            page,
-            "<tr class=\"{class}\" data-scenario=\"{}\" data-method=\"{}\" data-status=\"{}\" data-source=\"{}\"{}{}>\
-             <td class=\"text\">{}</td><td class=\"text\">{}{badge}</td><td class=\"text status\">{}</td>\
-             <td data-v=\"{}\">{}</td><td data-v=\"{}\">{}</td><td>{}</td>{}{}{}{}{}{}<td data-v=\"{}\">{}</td>",
-            escape(&r.scenario),
-            escape(&r.method),
-            r.status.kind(),
-            escape(&r.mesh_source),
-            member_attributes(r),
-            {
-                let stem = crate::stored_report::case_file_stem(&r.scenario, &r.method);
-                if context.viewable.contains(&stem) {
-                    format!(
-                        " data-view=\"{}\" data-rest=\"{}.rest\"",
-                        escape(&stem),
-                        escape(&crate::stored_report::file_name(&r.scenario))
-                    )
-                } else {
-                    String::new()
-                }
-            },
-            escape(&r.scenario),
-            escape(&r.method),
-            escape(&r.status.to_string()),
-            r.vertices,
-            r.vertices,
-            r.iterations,
-            r.iterations,
-            if r.convergence_unknown {
-                "unknown"
-            } else if r.converged {
-                "yes"
-            } else {
-                "no"
-            },
-            timing(r.startup_s, r.spread.map(|s| (s.repetitions, s.startup_s)), 3),
-            timing(r.precompute_s, r.spread.map(|s| (s.repetitions, s.precompute_s)), 3),
-            timing(r.bind_s, r.spread.map(|s| (s.repetitions, s.bind_s)), 4),
-            timing(r.solve_s, r.spread.map(|s| (s.repetitions, s.solve_s)), 3),
-            timing(r.total_s, r.spread.map(|s| (s.repetitions, s.total_s)), 3),
-            timing(r.median_iteration_ms, r.spread.map(|s| (s.repetitions, s.median_iteration_ms)), 3),
-            sort_value(r.peak_memory_mib),
-            number(r.peak_memory_mib, 0),
-        );
-        for spec in &METRICS {
-            let value = r.quality.get(spec.metric);
-            let _ = write!(
-                page,
-                "<td data-v=\"{}\">{}</td>",
-                value.map_or(String::new(), sort_value),
-                escape(&spec.format.apply(value))
-            );
-        }
-        let _ = writeln!(
-            page,
-            "<td>{}</td></tr>",
-            r.self_intersecting.map_or("not checked", |b| if b { "yes" } else { "no" }),
+            cells,
+            "<td data-v=\"{}\">{}</td>",
+            value.map_or(String::new(), sort_value),
+            escape(&spec.format.apply(value))
         );
     }
-    page.push_str("</tbody></table></div>\n");
+    cells
 }
 
 /// The 3D view (filled by `viewer.js` when a row is clicked).
