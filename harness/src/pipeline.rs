@@ -8,6 +8,7 @@ use std::time::Instant;
 use crate::error::HarnessError;
 use crate::record::CaseResult;
 use crate::regression::{self, BaselineKind, GateOutcome};
+use crate::report::document::{Document, Image, Table};
 use crate::report::{self, html, peer_comparison, plots, render, MeshOutput};
 use crate::suite::{SuiteOptions, SuiteRun};
 use crate::{self_intersection, shard::Shard};
@@ -127,7 +128,7 @@ pub struct PublishOptions {
 pub struct Outcome {
     /// The regression gate's findings, or why it did not compare.
     pub gate: GateOutcome,
-    /// Our ARAP against libigl's (markdown, `peers.md`), empty without the peers.
+    /// Our ARAP against libigl's (Markdown, as in `peers.md`), empty without the peers.
     pub arap_against_libigl: String,
     /// Cases whose status is `suspect`.
     pub suspect: usize,
@@ -149,26 +150,87 @@ pub fn publish(
     publish: &PublishOptions,
     gate: GateRequest,
 ) -> Result<Outcome, HarnessError> {
-    let mut seconds = [0.0; RunPhase::ALL.len()];
-    seconds[RunPhase::Methods as usize] = run.results.iter().map(method_seconds).sum();
-    seconds[RunPhase::TraceQuality as usize] = run.results.iter().map(|r| r.overhead.trace_quality_s).sum();
-    seconds[RunPhase::Evaluation as usize] = run.results.iter().map(|r| r.overhead.evaluation_s).sum();
-    let mut timed = |phase: RunPhase, start: Instant| seconds[phase as usize] = start.elapsed().as_secs_f64();
-
-    let start = Instant::now();
-    if let Some(python) = &publish.peer_python {
-        let answers = self_intersection::self_intersections(python, &run.results, &run.scenarios)
-            .map_err(|e| HarnessError::Report(format!("self-intersection check (open3d): {e}")))?;
-        for (r, answer) in run.results.iter_mut().zip(answers) {
-            r.self_intersecting = answer;
-        }
-    }
-    timed(RunPhase::PeerChecks, start);
-
     let dir = &options.reports_dir;
-    let start = Instant::now();
-    let peers =
-        peer_comparison::render_markdown(&peer_comparison::arap_against_libigl(&run.results, &run.scenarios));
+    let mut clock = PhaseClock::after_the_cases(&run.results);
+    clock.time(RunPhase::PeerChecks, || check_self_intersections(run, publish))?;
+    let reports = clock.time(RunPhase::Reports, || write_reports(dir, run, publish))?;
+    let mut images = clock.time(RunPhase::Plots, || plots::write_plots(dir, &run.results))?;
+    images
+        .extend(clock.time(RunPhase::Figures, || render::write_figures(dir, &run.results, &run.scenarios))?);
+    let gate = clock.time(RunPhase::GateAndIndex, || {
+        let gate = gate_outcome(gate, &run.results)?;
+        write_page(dir, run, &reports, &images, &gate)?;
+        Ok::<_, HarnessError>(gate)
+    })?;
+    Ok(Outcome {
+        gate,
+        arap_against_libigl: peer_comparison::document(&reports.peers).to_markdown(),
+        suspect: run.results.iter().filter(|r| r.status.is_suspect()).count(),
+        unfinished: run.results.iter().filter(|r| r.status.is_unfinished()).count(),
+        failed: run.results.iter().filter(|r| r.status.is_failed()).count(),
+        phases: clock.phases(),
+    })
+}
+
+/// The wall seconds of each phase of a run ([`RunPhase::ALL`] order).
+struct PhaseClock {
+    seconds: [f64; RunPhase::ALL.len()],
+}
+
+impl PhaseClock {
+    /// The phases the cases timed themselves: the methods', the iterates' quality, the evaluation.
+    fn after_the_cases(results: &[CaseResult]) -> PhaseClock {
+        let mut seconds = [0.0; RunPhase::ALL.len()];
+        seconds[RunPhase::Methods as usize] = results.iter().map(method_seconds).sum();
+        seconds[RunPhase::TraceQuality as usize] = results.iter().map(|r| r.overhead.trace_quality_s).sum();
+        seconds[RunPhase::Evaluation as usize] = results.iter().map(|r| r.overhead.evaluation_s).sum();
+        PhaseClock { seconds }
+    }
+
+    /// Do `work` as `phase`, timed.
+    fn time<T>(&mut self, phase: RunPhase, work: impl FnOnce() -> T) -> T {
+        let start = Instant::now();
+        let out = work();
+        self.seconds[phase as usize] = start.elapsed().as_secs_f64();
+        out
+    }
+
+    fn phases(&self) -> Vec<(RunPhase, f64)> {
+        RunPhase::ALL.into_iter().zip(self.seconds).collect()
+    }
+}
+
+/// open3d's self-intersection answer for every result, when `publish` asks for it.
+fn check_self_intersections(run: &mut SuiteRun, publish: &PublishOptions) -> Result<(), HarnessError> {
+    let Some(python) = &publish.peer_python else { return Ok(()) };
+    let answers = self_intersection::self_intersections(python, &run.results, &run.scenarios)
+        .map_err(|e| HarnessError::Report(format!("self-intersection check (open3d): {e}")))?;
+    for (r, answer) in run.results.iter_mut().zip(answers) {
+        r.self_intersecting = answer;
+    }
+    Ok(())
+}
+
+/// What the reports written before the page hand on to it.
+struct WrittenReports {
+    /// Our ARAP against libigl's (`peers.md`).
+    peers: Table,
+    /// `dataset.md` (empty: not written).
+    dataset: Document,
+    /// `size-series.md` (empty: not written).
+    size_series: Document,
+    /// The case file stems that open in the 3D view.
+    viewable: Vec<String>,
+}
+
+/// Write the tables, the result meshes and the 3D view's files, `pareto.md`, `dataset.md` and
+/// `size-series.md` of `run` under `dir`.
+fn write_reports(
+    dir: &Path,
+    run: &SuiteRun,
+    publish: &PublishOptions,
+) -> Result<WrittenReports, HarnessError> {
+    let peers = peer_comparison::table(&peer_comparison::arap_against_libigl(&run.results, &run.scenarios));
     report::write_reports(
         dir,
         &run.results,
@@ -176,67 +238,59 @@ pub fn publish(
         &run.data_source,
         &run.provenance,
         &run.skipped,
-        &peers,
+        &peer_comparison::document(&peers),
         &publish.meshes,
     )?;
     let viewable = report::viewer::write_viewer_data(dir, &run.results, &run.scenarios, |s| {
         publish.meshes.every_scenario || s.writes_result_meshes()
     })?;
     report::quality_time::write_markdown(dir, &run.results)?;
-    let dataset = report::dataset::render_markdown(&run.results, &run.skipped);
+    let dataset = report::dataset::document(&run.results, &run.skipped);
     if !dataset.is_empty() {
-        report::dataset::write_markdown(dir, &dataset)?;
+        dataset.write_markdown(&dir.join("dataset.md"))?;
     }
-    let size_series = report::size_series::render_markdown(&run.results, &run.scenarios);
+    let size_series = report::size_series::document(&run.results, &run.scenarios);
     if !size_series.is_empty() {
-        report::size_series::write_markdown(dir, &size_series)?;
+        size_series.write_markdown(&dir.join("size-series.md"))?;
     }
-    timed(RunPhase::Reports, start);
+    Ok(WrittenReports { peers, dataset, size_series, viewable })
+}
 
-    let start = Instant::now();
-    let mut images = plots::write_plots(dir, &run.results)?;
-    timed(RunPhase::Plots, start);
-
-    let start = Instant::now();
-    images.extend(render::write_figures(dir, &run.results, &run.scenarios)?);
-    timed(RunPhase::Figures, start);
-
-    let start = Instant::now();
-    let outcome = match gate {
+/// The regression gate's verdict on `results`, or why it did not compare.
+fn gate_outcome(gate: GateRequest, results: &[CaseResult]) -> Result<GateOutcome, HarnessError> {
+    match gate {
         GateRequest::Compare(baseline) => {
-            regression::gate(&baseline_path(baseline.as_deref(), &run.results)?, &run.results)?
+            regression::gate(&baseline_path(baseline.as_deref(), results)?, results)
         }
-        GateRequest::Skip(reason) => GateOutcome::NotChecked(reason),
-    };
-    let table1 = report::render_table1(&run.results);
-    html::write_index(
-        dir,
-        &html::render_index(&html::PageContext {
-            results: &run.results,
-            data_source: &run.data_source,
-            provenance: &run.provenance.summary(),
-            images: &images,
-            table1_markdown: &table1,
-            peers: &peers,
-            gate: &outcome,
-            notes: &run.notes,
-            scenarios: &run.scenarios,
-            skipped: &run.skipped,
-            viewable: &viewable,
-            dataset: &dataset,
-            size_series: &size_series,
-        }),
-    )?;
-    timed(RunPhase::GateAndIndex, start);
+        GateRequest::Skip(reason) => Ok(GateOutcome::NotChecked(reason)),
+    }
+}
 
-    Ok(Outcome {
-        gate: outcome,
-        arap_against_libigl: peers,
-        suspect: run.results.iter().filter(|r| r.status.is_suspect()).count(),
-        unfinished: run.results.iter().filter(|r| r.status.is_unfinished()).count(),
-        failed: run.results.iter().filter(|r| r.status.is_failed()).count(),
-        phases: RunPhase::ALL.into_iter().zip(seconds).collect(),
-    })
+/// Write `index.html` of `run` under `dir`: its reports, its `images` and the `gate`'s verdict.
+fn write_page(
+    dir: &Path,
+    run: &SuiteRun,
+    reports: &WrittenReports,
+    images: &[Image],
+    gate: &GateOutcome,
+) -> Result<PathBuf, HarnessError> {
+    let table1 = report::table1(&run.results);
+    let page = html::render_index(&html::PageContext {
+        results: &run.results,
+        data_source: &run.data_source,
+        provenance: &run.provenance.summary(),
+        images,
+        table1: &table1,
+        peers: &reports.peers,
+        gate,
+        notes: &run.notes,
+        scenarios: &run.scenarios,
+        skipped: &run.skipped,
+        viewable: &reports.viewable,
+        dataset: &reports.dataset,
+        size_series: &reports.size_series,
+    });
+    html::write_index(dir, &page)
 }
 
 /// Write part `shard` of a run (`run` holds that part's cases): `results.json` and every result

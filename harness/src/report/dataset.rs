@@ -12,8 +12,8 @@
 //! [`super::render`].
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 
+use super::document::{Document, Table, Text};
 use crate::metrics::{percentile, Metric};
 use crate::pareto::TimeAxis;
 use crate::record::CaseResult;
@@ -162,37 +162,52 @@ fn time(s: f64) -> String {
 
 /// `dataset.md`: every table of the module doc, for the dataset cases of `results` and the
 /// `skipped` meshes; empty when the run has no collection.
-pub fn render_markdown(results: &[CaseResult], skipped: &[SkippedInput]) -> String {
+pub fn document(results: &[CaseResult], skipped: &[SkippedInput]) -> Document {
+    let mut document = Document::default();
     let cases = dataset_cases(results);
     if cases.is_empty() {
-        return String::new();
+        return document;
     }
-    let families = families(&cases);
     let methods = methods_of(&cases);
+    document.heading(1, "Across the dataset");
+    document.paragraph(summary(&cases, skipped));
+    document.heading(2, "Robustness");
+    document.table(robustness_table(&cases, &methods, skipped));
+    document.heading(2, "Why suspect");
+    document.table(reasons_table(&cases, &methods));
+    error_spread_cost_and_rank(&mut document, &cases, &methods);
+    document.heading(2, "Cost growth");
+    document.table(cost_growth_table(&cases, &methods));
+    worst_ok_results(&mut document, &cases);
+    inputs_and_failures(&mut document, &cases, skipped);
+    document
+}
+
+/// How many cases, families, methods and meshes ran, and how many meshes were skipped.
+fn summary(cases: &[&CaseResult], skipped: &[SkippedInput]) -> String {
     let meshes: std::collections::BTreeSet<&str> =
         cases.iter().filter_map(|c| c.member.as_ref().map(|m| m.mesh.as_str())).collect();
-    let mut md = String::new();
-    let _ = writeln!(
-        md,
-        "# Across the dataset\n\n{} cases: {} edit families × {} methods on {} meshes that ran; {} (family, mesh) \
-         pairs skipped before any method ran (listed at the end).\n",
+    format!(
+        "{} cases: {} edit families × {} methods on {} meshes that ran; {} (family, mesh) pairs skipped \
+         before any method ran (listed at the end).",
         cases.len(),
-        families.len(),
-        methods.len(),
+        families(cases).len(),
+        methods_of(cases).len(),
         meshes.len(),
         skipped.len()
-    );
+    )
+}
 
-    md.push_str("## Robustness\n\nCases per status (ok / suspect / unfinished / failed), and the meshes of the family skipped at load (every method alike).\n\n");
-    let _ = write!(md, "| method |");
-    for f in &families {
-        let _ = write!(md, " {f} |");
-    }
-    md.push_str(" all |\n|---|");
-    md.push_str(&"---|".repeat(families.len() + 1));
-    md.push('\n');
-    for m in &methods {
-        let _ = write!(md, "| {m} |");
+/// Per method and family (and all families), the cases per status; then the meshes of each family
+/// skipped at load.
+fn robustness_table(cases: &[&CaseResult], methods: &[&str], skipped: &[SkippedInput]) -> Table {
+    let families = families(cases);
+    let mut table = Table::new(std::iter::once("method").chain(families.iter().copied()).chain(["all"]))
+        .captioned(
+            "Cases per status (ok / suspect / unfinished / failed), and the meshes of the family skipped at \
+             load (every method alike).",
+        );
+    for m in methods {
         let counts = |family: Option<&str>| {
             let of: Vec<&&CaseResult> =
                 cases.iter().filter(|c| c.method == *m && family.is_none_or(|f| family_of(c) == f)).collect();
@@ -202,100 +217,146 @@ pub fn render_markdown(results: &[CaseResult], skipped: &[SkippedInput]) -> Stri
                 .collect::<Vec<_>>()
                 .join(" / ")
         };
-        for f in &families {
-            let _ = write!(md, " {} |", counts(Some(f)));
-        }
-        let _ = writeln!(md, " {} |", counts(None));
+        let per_family = families.iter().map(|f| counts(Some(f)));
+        table.push_row(std::iter::once(m.to_string()).chain(per_family).chain([counts(None)]));
     }
-    let _ = write!(md, "| skipped meshes |");
-    for f in &families {
-        let _ = write!(md, " {} |", skipped.iter().filter(|s| s.member.collection == *f).count());
-    }
-    let _ = writeln!(md, " {} |\n", skipped.len());
-
-    md.push_str(&reasons_table(&cases, &methods));
-
-    let ranks = ranks(&cases);
-    md.push_str(
-        "## Error spread, cost and rank\n\nMedian and 90th percentile over the cases with a finished shape \
-         (ok or suspect); times are medians over the cases that ran (failed ones have none); rank by E_phi \
-         among the methods on the same mesh and edit (1 = best; unfinished and failed cases take the last rank).\n\n",
+    let per_family =
+        families.iter().map(|f| skipped.iter().filter(|s| s.member.collection == *f).count().to_string());
+    table.push_row(
+        std::iter::once("skipped meshes".to_string()).chain(per_family).chain([skipped.len().to_string()]),
     );
-    let header =
-        SPREAD_MEASURES.iter().map(|m| format!(" {} median / p90 |", m.spec().label)).collect::<String>();
-    for family in families.iter().map(|f| Some(*f)).chain([None]) {
-        let _ = writeln!(md, "### {}\n", family.unwrap_or("all families"));
-        let _ = writeln!(md, "| method | finished |{header} time per edit | with precompute | median rank |");
-        md.push_str(&"|---".repeat(SPREAD_MEASURES.len() + 5));
-        md.push_str("|\n");
-        for m in &methods {
-            let of: Vec<&CaseResult> = cases
-                .iter()
-                .copied()
-                .filter(|c| c.method == *m && family.is_none_or(|f| family_of(c) == f))
-                .collect();
-            let done: Vec<&CaseResult> = of.iter().copied().filter(|c| finished(c)).collect();
-            let _ = write!(md, "| {m} | {} of {} |", done.len(), of.len());
-            for measure in SPREAD_MEASURES {
-                let (median, p90) = median_and_p90(done.iter().map(|c| c.metric(measure)));
-                let _ = write!(md, " {} / {} |", num(median), num(p90));
-            }
-            let ran = || of.iter().filter(|c| !c.status.is_failed());
-            let (edit, _) = median_and_p90(ran().map(|c| TimeAxis::Edit.seconds(c)));
-            let (with, _) = median_and_p90(ran().map(|c| TimeAxis::WithPrecompute.seconds(c)));
-            let rank: Vec<f64> = of
-                .iter()
-                .filter_map(|c| ranks.get(&(c.scenario.clone(), c.method.clone())))
-                .map(|&r| r as f64)
-                .collect();
-            let (rank, _) = median_and_p90(rank.into_iter());
-            let _ = writeln!(md, " {} | {} | {} |", time(edit), time(with), num(rank));
-        }
-        md.push('\n');
-    }
+    table
+}
 
-    md.push_str(
-        "## Cost growth\n\nLeast-squares slope of log time against log #V over every case of the method that ran \
-         (all families): 1 is linear in the mesh size. The reduced models claim a per-iteration cost \
-         independent of #V (slope near 0) and pay for it in the precompute.\n\n\
-         | method | cases | time per edit | per iteration | precompute |\n|---|---|---|---|---|\n",
+/// Per method, how many cases (all families) carry each kind of shape reason
+/// ([`crate::verdict::REASON_KINDS`]; a case may have several): what makes the suspect cases suspect.
+fn reasons_table(cases: &[&CaseResult], methods: &[&str]) -> Table {
+    let mut table = Table::new(std::iter::once("method").chain(REASON_KINDS)).captioned(
+        "Cases of all families whose shape a verdict flags, per reason (a case may have several; unfinished \
+         cases count too, their shape reasons follow the cap).",
     );
-    for m in &methods {
+    for m in methods {
+        let counts = REASON_KINDS.iter().map(|kind| {
+            cases
+                .iter()
+                .filter(|c| c.method == *m && c.status.shape_reasons().any(|r| reason_kind(r) == Some(kind)))
+                .count()
+                .to_string()
+        });
+        table.push_row(std::iter::once(m.to_string()).chain(counts));
+    }
+    table
+}
+
+/// "Error spread, cost and rank": what the tables give, then a table per family and one over all
+/// families.
+fn error_spread_cost_and_rank(document: &mut Document, cases: &[&CaseResult], methods: &[&str]) {
+    document.heading(2, "Error spread, cost and rank");
+    document.paragraph(
+        "Median and 90th percentile over the cases with a finished shape (ok or suspect); times are medians \
+         over the cases that ran (failed ones have none); rank by E_phi among the methods on the same mesh and \
+         edit (1 = best; unfinished and failed cases take the last rank).",
+    );
+    let ranks = ranks(cases);
+    for family in families(cases).into_iter().map(Some).chain([None]) {
+        document.heading(3, family.unwrap_or("all families"));
+        document.table(spread_table(cases, methods, family, &ranks));
+    }
+}
+
+/// Per method, over the cases of `family` (all: `None`): the spread of each measure of
+/// [`SPREAD_MEASURES`], the median times and the median rank.
+fn spread_table(
+    cases: &[&CaseResult],
+    methods: &[&str],
+    family: Option<&str>,
+    ranks: &BTreeMap<(String, String), usize>,
+) -> Table {
+    let spreads = SPREAD_MEASURES.iter().map(|m| format!("{} median / p90", m.spec().label));
+    let titles = ["method", "finished"].map(String::from).into_iter().chain(spreads);
+    let mut table =
+        Table::new(titles.chain(["time per edit", "with precompute", "median rank"].map(String::from)));
+    for m in methods {
+        let of: Vec<&CaseResult> = cases
+            .iter()
+            .copied()
+            .filter(|c| c.method == *m && family.is_none_or(|f| family_of(c) == f))
+            .collect();
+        let done: Vec<&CaseResult> = of.iter().copied().filter(|c| finished(c)).collect();
+        let mut cells = vec![m.to_string(), format!("{} of {}", done.len(), of.len())];
+        for measure in SPREAD_MEASURES {
+            let (median, p90) = median_and_p90(done.iter().map(|c| c.metric(measure)));
+            cells.push(format!("{} / {}", num(median), num(p90)));
+        }
+        let ran = || of.iter().filter(|c| !c.status.is_failed());
+        let (edit, _) = median_and_p90(ran().map(|c| TimeAxis::Edit.seconds(c)));
+        let (with, _) = median_and_p90(ran().map(|c| TimeAxis::WithPrecompute.seconds(c)));
+        let rank = of.iter().filter_map(|c| ranks.get(&(c.scenario.clone(), c.method.clone())));
+        let (rank, _) = median_and_p90(rank.map(|&r| r as f64));
+        cells.extend([time(edit), time(with), num(rank)]);
+        table.push_row(cells);
+    }
+    table
+}
+
+/// Per method, the slope of log time against log #V over its cases that ran (all families).
+fn cost_growth_table(cases: &[&CaseResult], methods: &[&str]) -> Table {
+    let mut table = Table::new(["method", "cases", "time per edit", "per iteration", "precompute"])
+        .captioned(
+            "Least-squares slope of log time against log #V over every case of the method that ran (all \
+         families): 1 is linear in the mesh size. The reduced models claim a per-iteration cost independent \
+         of #V (slope near 0) and pay for it in the precompute.",
+        );
+    for m in methods {
         let of: Vec<&CaseResult> =
             cases.iter().copied().filter(|c| c.method == *m && !c.status.is_failed()).collect();
         let slope = |t: &dyn Fn(&CaseResult) -> f64| cost_slope(of.iter().map(|c| (c.vertices, t(c)))).0;
-        let _ = writeln!(
-            md,
-            "| {m} | {} | {} | {} | {} |",
-            of.len(),
+        table.push_row([
+            m.to_string(),
+            of.len().to_string(),
             num(slope(&|c| TimeAxis::Edit.seconds(c))),
             num(slope(&|c| c.median_iteration_ms)),
-            num(slope(&|c| c.precompute_s))
-        );
+            num(slope(&|c| c.precompute_s)),
+        ]);
     }
+    table
+}
 
-    md.push_str("\n## Worst ok results\n\nPer family, each method's five `ok` cases with the largest E_phi (the sheets `figures/worst-<family>.png` draw them beside arap's result): garbage called ok is one look away.\n\n");
-    for (family, method, worst) in worst_ok(&cases) {
+/// "Worst ok results": per family and method the worst `ok` meshes by [`RANK_MEASURE`].
+fn worst_ok_results(document: &mut Document, cases: &[&CaseResult]) {
+    document.heading(2, "Worst ok results");
+    document.paragraph(
+        Text::plain("Per family, each method's five ")
+            .then_code("ok")
+            .then(" cases with the largest E_phi (the sheets ")
+            .then_code("figures/worst-<family>.png")
+            .then(" draw them beside arap's result): garbage called ok is one look away."),
+    );
+    let items = worst_ok(cases).into_iter().map(|(family, method, worst)| {
         let list = worst
             .iter()
             .map(|c| {
-                format!(
-                    "{} ({}°)",
-                    c.member.as_ref().map_or("", |m| m.mesh.as_str()),
-                    num(c.metric(RANK_MEASURE))
-                )
+                let mesh = c.member.as_ref().map_or("", |m| m.mesh.as_str());
+                format!("{mesh} ({}°)", num(c.metric(RANK_MEASURE)))
             })
             .collect::<Vec<_>>()
             .join(", ");
-        let _ = writeln!(md, "- {family} / {method}: {list}");
-    }
+        Text::plain(format!("{family} / {method}: {list}"))
+    });
+    document.list(items.collect());
+}
 
-    let failed: Vec<&&CaseResult> = cases.iter().filter(|c| c.status.is_failed()).collect();
+/// The failed cases, the meshes `repair = true` changed and the skipped meshes, each when there are
+/// any.
+fn inputs_and_failures(document: &mut Document, cases: &[&CaseResult], skipped: &[SkippedInput]) {
+    let failed: Vec<Text> = cases
+        .iter()
+        .filter(|c| c.status.is_failed())
+        .map(|c| Text::plain(format!("{} / {}: {}", c.scenario, c.method, c.status)))
+        .collect();
     if !failed.is_empty() {
-        md.push_str("\n## Failed cases\n\n");
-        for c in failed {
-            let _ = writeln!(md, "- {} / {}: {}", c.scenario, c.method, c.status);
-        }
+        document.heading(2, "Failed cases");
+        document.list(failed);
     }
     let mut repaired: Vec<(&str, &str)> = cases
         .iter()
@@ -305,54 +366,16 @@ pub fn render_markdown(results: &[CaseResult], skipped: &[SkippedInput]) -> Stri
     repaired.sort();
     repaired.dedup();
     if !repaired.is_empty() {
-        md.push_str("\n## Repaired meshes (`repair = true`)\n\n");
-        for (mesh, what) in repaired {
-            let _ = writeln!(md, "- {mesh}: {what}");
-        }
+        document.heading(2, Text::plain("Repaired meshes (").then_code("repair = true").then(")"));
+        document
+            .list(repaired.into_iter().map(|(mesh, what)| Text::plain(format!("{mesh}: {what}"))).collect());
     }
     if !skipped.is_empty() {
-        md.push_str("\n## Skipped meshes\n\n");
-        for s in skipped {
-            let _ = writeln!(md, "- skipped: {} ({}): {}", s.scenario, s.file.display(), s.reason);
-        }
+        document.heading(2, "Skipped meshes");
+        let items =
+            skipped.iter().map(|s| format!("skipped: {} ({}): {}", s.scenario, s.file.display(), s.reason));
+        document.list(items.map(Text::plain).collect());
     }
-    md
-}
-
-/// Per method, how many cases (all families) carry each kind of shape reason
-/// ([`crate::verdict::REASON_KINDS`]; a case may have several): what makes the suspect cases suspect.
-fn reasons_table(cases: &[&CaseResult], methods: &[&str]) -> String {
-    let mut md = String::from(
-        "## Why suspect\n\nCases of all families whose shape a verdict flags, per reason (a case may have \
-         several; unfinished cases count too, their shape reasons follow the cap).\n\n| method |",
-    );
-    for kind in REASON_KINDS {
-        let _ = write!(md, " {kind} |");
-    }
-    md.push('\n');
-    md.push_str(&"|---".repeat(REASON_KINDS.len() + 1));
-    md.push_str("|\n");
-    for m in methods {
-        let _ = write!(md, "| {m} |");
-        for kind in REASON_KINDS {
-            let n = cases
-                .iter()
-                .filter(|c| c.method == *m && c.status.shape_reasons().any(|r| reason_kind(r) == Some(kind)))
-                .count();
-            let _ = write!(md, " {n} |");
-        }
-        md.push('\n');
-    }
-    md.push('\n');
-    md
-}
-
-/// Write `dataset.md` (`markdown`, from [`render_markdown`]) under `dir`, atomically.
-pub fn write_markdown(dir: &std::path::Path, markdown: &str) -> Result<(), crate::error::HarnessError> {
-    meshes::io::atomic_write(dir.join("dataset.md"), |w| {
-        w.write_all(markdown.as_bytes()).map_err(meshes::MeshError::from)
-    })
-    .map_err(crate::error::HarnessError::from)
 }
 
 #[cfg(test)]
@@ -453,13 +476,13 @@ mod tests {
                 repaired: None,
             },
         }];
-        let md = render_markdown(&cases, &skipped);
+        let md = document(&cases, &skipped).to_markdown();
         assert!(md.contains("| arap | 1 / 0 / 0 / 1 | 1 / 0 / 0 / 1 |"), "{md}");
         assert!(md.contains("| skipped meshes | 1 | 1 |"), "{md}");
         // Why suspect: hirm swells twice (suspect and unfinished) and folds once; arap is clean.
         assert!(md.contains("| hirm | 0 | 1 | 0 | 0 | 0 | 2 | 0 | 0 |"), "{md}");
         assert!(md.contains("| arap | 0 | 0 | 0 | 0 | 0 | 0 | 0 | 0 |"), "{md}");
         assert!(md.contains("skipped: bend-c (c.obj): face 3: zero area"), "{md}");
-        assert!(render_markdown(&[CaseResult::empty("bar", "arap", "survey", 1, 1)], &[]).is_empty());
+        assert!(document(&[CaseResult::empty("bar", "arap", "survey", 1, 1)], &[]).is_empty());
     }
 }

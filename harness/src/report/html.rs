@@ -9,16 +9,15 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use super::document::html::{figure, link};
+use super::document::{html as render, Block, Document, Image, ImageGroup, Table};
 use crate::config::Origin;
 use crate::error::HarnessError;
 use crate::metrics::METRICS;
 use crate::record::CaseResult;
 use crate::regression::GateOutcome;
 
-/// Escape text for HTML element content and attribute values.
-pub(crate) fn escape(text: &str) -> String {
-    text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
+pub(crate) use super::document::html::escape;
 
 fn number(v: f64, digits: usize) -> String {
     if v.is_finite() {
@@ -35,12 +34,12 @@ pub struct PageContext<'a> {
     pub data_source: &'a str,
     /// The run's provenance line.
     pub provenance: &'a str,
-    /// Plots and figures, relative to the report directory.
-    pub images: &'a [PathBuf],
-    /// HIRM's Table 1 as written to `table1.md`.
-    pub table1_markdown: &'a str,
-    /// Our ARAP against libigl's (`peers.md`; empty: none).
-    pub peers: &'a str,
+    /// Plots and figures (their PNGs, relative to the report directory).
+    pub images: &'a [Image],
+    /// HIRM's Table 1, as in `table1.md` (no rows: no scenario ran both of its sides).
+    pub table1: &'a Table,
+    /// Our ARAP against libigl's, as in `peers.md` (no rows: none).
+    pub peers: &'a Table,
     pub gate: &'a GateOutcome,
     /// Notes on the inputs.
     pub notes: &'a [String],
@@ -51,9 +50,9 @@ pub struct PageContext<'a> {
     /// The case file stems that open in the 3D view.
     pub viewable: &'a [String],
     /// `dataset.md` (empty: not a dataset run).
-    pub dataset: &'a str,
+    pub dataset: &'a Document,
     /// `size-series.md` (empty: no series).
-    pub size_series: &'a str,
+    pub size_series: &'a Document,
 }
 
 /// A section of the page: appends its HTML (nothing when it has nothing to show).
@@ -90,52 +89,29 @@ pub fn render_index(context: &PageContext) -> String {
     page
 }
 
-/// The groups the page shows its images in, by file name.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum ImageGroup {
-    /// `dataset-*`, `worst-*`: across the dataset.
-    Dataset,
-    /// `size-series*`: cost against size.
-    SizeSeries,
-    /// `figures/grid*`: the rendered result grids.
-    Grid,
-    /// Every other render under `figures/`.
-    Render,
-    /// `*-pareto`: quality against time.
-    Pareto,
-    /// The other plots.
-    Plot,
-}
-
-impl ImageGroup {
-    fn of(path: &Path) -> ImageGroup {
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        if name.starts_with("dataset-") || name.starts_with("worst-") {
-            ImageGroup::Dataset
-        } else if name.starts_with("size-series") {
-            ImageGroup::SizeSeries
-        } else if path.starts_with("figures") {
-            if name.starts_with("grid") {
-                ImageGroup::Grid
-            } else {
-                ImageGroup::Render
-            }
-        } else if caption_for(path).ends_with("-pareto") {
-            ImageGroup::Pareto
-        } else {
-            ImageGroup::Plot
-        }
-    }
-}
-
 impl PageContext<'_> {
-    /// The PNG images of `group`, in the run's order.
-    fn images(&self, group: ImageGroup) -> Vec<&PathBuf> {
-        self.images
-            .iter()
-            .filter(|p| p.extension().is_some_and(|e| e == "png") && ImageGroup::of(p) == group)
-            .collect()
+    /// The images of `group`, in the run's order.
+    fn images<'a>(&'a self, group: &'a ImageGroup) -> impl Iterator<Item = &'a Image> {
+        self.images.iter().filter(move |i| i.group == *group)
     }
+
+    /// The figures of the images of `group`.
+    fn figures(&self, group: &ImageGroup) -> String {
+        self.images(group).map(figure).collect()
+    }
+}
+
+/// `document`'s blocks as the page shows them under its section's own heading: its headings of
+/// `kept.0` as paragraphs that begin with `kept.1` (the families of `dataset.md`, the series of
+/// `size-series.md`), its other headings left out.
+fn under_section_heading(document: &Document, kept: (u8, &str)) -> Document {
+    let (level, label) = kept;
+    let blocks = document.blocks.iter().filter_map(|block| match block {
+        Block::Heading { level: l, text } if *l == level => Some(Block::Paragraph(text.clone().after(label))),
+        Block::Heading { .. } => None,
+        other => Some(other.clone()),
+    });
+    Document { blocks: blocks.collect() }
 }
 
 /// The document head, the title, the data source and the provenance.
@@ -228,11 +204,8 @@ fn across_the_dataset(page: &mut String, context: &PageContext) {
          then the error distributions, the cost curves and each family's worst <code>ok</code> results beside arap's. \
          The results table below filters by family, mesh, surface, genus and size.</p>\n",
     );
-    // The per-family headings of dataset.md, which markdown_table leaves out, as paragraphs.
-    page.push_str(&markdown_table(&context.dataset.replace("\n### ", "\nEdit family: ")));
-    for p in context.images(ImageGroup::Dataset) {
-        image(page, p, caption_for(p));
-    }
+    page.push_str(&under_section_heading(context.dataset, (3, "Edit family: ")).to_html());
+    page.push_str(&context.figures(&ImageGroup::Dataset));
 }
 
 /// Cost against size: `size-series.md` and its plots.
@@ -243,15 +216,23 @@ fn cost_against_size(page: &mut String, context: &PageContext) {
     page.push_str(
         "<h2 id=\"size-series\">Cost against size</h2>\n<p>(Also in <code>size-series.md</code>.)</p>\n",
     );
-    page.push_str(&markdown_table(&context.size_series.replace("\n## ", "\nSeries: ")));
-    for p in context.images(ImageGroup::SizeSeries) {
-        image(page, p, caption_for(p));
-    }
+    page.push_str(&under_section_heading(context.size_series, (2, "Series: ")).to_html());
+    page.push_str(&context.figures(&ImageGroup::SizeSeries));
 }
 
 /// The results table: a row per case, every timing and measure, sortable and filtered by the page
 /// script; a row with a result mesh opens the 3D view.
 fn results_table(page: &mut String, context: &PageContext) {
+    results_header(page);
+    for r in context.results {
+        result_row(page, r, context.viewable);
+    }
+    page.push_str("</tbody></table></div>\n");
+}
+
+/// The section's heading, the filters' place and the table's header row: a column per timing and
+/// measure, each with the key the page script sorts and ranks by.
+fn results_header(page: &mut String) {
     page.push_str(
         "<h2 id=\"results\">Results</h2>\n<div id=\"filters\"></div>\n<div class=\"scroll\"><table id=\"results-table\">\n<thead><tr>\
          <th data-key=\"scenario\">scenario</th><th data-key=\"method\">method</th>\
@@ -275,92 +256,119 @@ fn results_table(page: &mut String, context: &PageContext) {
     page.push_str(
         "<th data-key=\"self_intersecting\">self-intersecting (open3d)</th></tr></thead>\n<tbody>\n",
     );
-    for r in context.results {
-        let (class, badge) = match r.origin {
-            Origin::BuiltIn => (
-                r.status.kind().to_string(),
-                r.reused_solve.as_ref().map_or(String::new(), |reused| {
-                    format!(
-                        "<span class=\"origin\" title=\"{}\">reuses {}</span>",
-                        escape(&format!(
-                            "its solve time includes {:.3} s of {}'s identical solve on this case, \
-                             taken from that case instead of computed again",
-                            reused.seconds, reused.from
-                        )),
-                        escape(&reused.from)
-                    )
-                }),
-            ),
-            other => (
-                format!("{} {}", r.status.kind(), other.label()),
+}
+
+/// One case's row: its data attributes for the filters and the 3D view, then its cells.
+fn result_row(page: &mut String, r: &CaseResult, viewable: &[String]) {
+    let (class, badge) = origin_mark(r);
+    let _ = write!(
+        page,
+        "<tr class=\"{class}\" data-scenario=\"{}\" data-method=\"{}\" data-status=\"{}\" data-source=\"{}\"{}{}>\
+         <td class=\"text\">{}</td><td class=\"text\">{}{badge}</td><td class=\"text status\">{}</td>\
+         <td data-v=\"{}\">{}</td><td data-v=\"{}\">{}</td><td>{}</td>",
+        escape(&r.scenario),
+        escape(&r.method),
+        r.status.kind(),
+        escape(&r.mesh_source),
+        member_attributes(r),
+        view_attributes(r, viewable),
+        escape(&r.scenario),
+        escape(&r.method),
+        escape(&r.status.to_string()),
+        r.vertices,
+        r.vertices,
+        r.iterations,
+        r.iterations,
+        if r.convergence_unknown {
+            "unknown"
+        } else if r.converged {
+            "yes"
+        } else {
+            "no"
+        },
+    );
+    page.push_str(&timing_cells(r));
+    page.push_str(&measure_cells(r));
+    let _ = writeln!(
+        page,
+        "<td>{}</td></tr>",
+        r.self_intersecting.map_or("not checked", |b| if b { "yes" } else { "no" }),
+    );
+}
+
+/// A row's class (its status, and its origin when not built in) and the mark beside its method: a
+/// peer's or an external program's origin, or the method whose identical solve it reuses.
+fn origin_mark(r: &CaseResult) -> (String, String) {
+    match r.origin {
+        Origin::BuiltIn => (
+            r.status.kind().to_string(),
+            r.reused_solve.as_ref().map_or(String::new(), |reused| {
                 format!(
-                    "<span class=\"origin\" title=\"{}\">{}</span>",
-                    escape(r.about.as_deref().unwrap_or("")),
-                    other.label()
-                ),
+                    "<span class=\"origin\" title=\"{}\">reuses {}</span>",
+                    escape(&format!(
+                        "its solve time includes {:.3} s of {}'s identical solve on this case, \
+                         taken from that case instead of computed again",
+                        reused.seconds, reused.from
+                    )),
+                    escape(&reused.from)
+                )
+            }),
+        ),
+        other => (
+            format!("{} {}", r.status.kind(), other.label()),
+            format!(
+                "<span class=\"origin\" title=\"{}\">{}</span>",
+                escape(r.about.as_deref().unwrap_or("")),
+                other.label()
             ),
-        };
+        ),
+    }
+}
+
+/// The attributes that open a case in the 3D view (its mesh files' stems), when it has them.
+fn view_attributes(r: &CaseResult, viewable: &[String]) -> String {
+    let stem = crate::stored_report::case_file_stem(&r.scenario, &r.method);
+    if viewable.contains(&stem) {
+        format!(
+            " data-view=\"{}\" data-rest=\"{}.rest\"",
+            escape(&stem),
+            escape(&crate::stored_report::file_name(&r.scenario))
+        )
+    } else {
+        String::new()
+    }
+}
+
+/// The timing cells (startup, precompute, bind, solve, total, iteration) and the peak memory.
+fn timing_cells(r: &CaseResult) -> String {
+    let spread = |phase: fn(&crate::record::TimingSpread) -> crate::record::Spread| {
+        r.spread.map(|s| (s.repetitions, phase(&s)))
+    };
+    [
+        timing(r.startup_s, spread(|s| s.startup_s), 3),
+        timing(r.precompute_s, spread(|s| s.precompute_s), 3),
+        timing(r.bind_s, spread(|s| s.bind_s), 4),
+        timing(r.solve_s, spread(|s| s.solve_s), 3),
+        timing(r.total_s, spread(|s| s.total_s), 3),
+        timing(r.median_iteration_ms, spread(|s| s.median_iteration_ms), 3),
+        format!("<td data-v=\"{}\">{}</td>", sort_value(r.peak_memory_mib), number(r.peak_memory_mib, 0)),
+    ]
+    .concat()
+}
+
+/// A cell per measure of [`METRICS`]: the value as the measure formats it, sorted by the full number.
+fn measure_cells(r: &CaseResult) -> String {
+    let mut cells = String::new();
+    for spec in &METRICS {
+        let value = r.quality.get(spec.metric);
         let _ = write!(
-            page,
-            "<tr class=\"{class}\" data-scenario=\"{}\" data-method=\"{}\" data-status=\"{}\" data-source=\"{}\"{}{}>\
-             <td class=\"text\">{}</td><td class=\"text\">{}{badge}</td><td class=\"text status\">{}</td>\
-             <td data-v=\"{}\">{}</td><td data-v=\"{}\">{}</td><td>{}</td>{}{}{}{}{}{}<td data-v=\"{}\">{}</td>",
-            escape(&r.scenario),
-            escape(&r.method),
-            r.status.kind(),
-            escape(&r.mesh_source),
-            member_attributes(r),
-            {
-                let stem = crate::stored_report::case_file_stem(&r.scenario, &r.method);
-                if context.viewable.contains(&stem) {
-                    format!(
-                        " data-view=\"{}\" data-rest=\"{}.rest\"",
-                        escape(&stem),
-                        escape(&crate::stored_report::file_name(&r.scenario))
-                    )
-                } else {
-                    String::new()
-                }
-            },
-            escape(&r.scenario),
-            escape(&r.method),
-            escape(&r.status.to_string()),
-            r.vertices,
-            r.vertices,
-            r.iterations,
-            r.iterations,
-            if r.convergence_unknown {
-                "unknown"
-            } else if r.converged {
-                "yes"
-            } else {
-                "no"
-            },
-            timing(r.startup_s, r.spread.map(|s| (s.repetitions, s.startup_s)), 3),
-            timing(r.precompute_s, r.spread.map(|s| (s.repetitions, s.precompute_s)), 3),
-            timing(r.bind_s, r.spread.map(|s| (s.repetitions, s.bind_s)), 4),
-            timing(r.solve_s, r.spread.map(|s| (s.repetitions, s.solve_s)), 3),
-            timing(r.total_s, r.spread.map(|s| (s.repetitions, s.total_s)), 3),
-            timing(r.median_iteration_ms, r.spread.map(|s| (s.repetitions, s.median_iteration_ms)), 3),
-            sort_value(r.peak_memory_mib),
-            number(r.peak_memory_mib, 0),
-        );
-        for spec in &METRICS {
-            let value = r.quality.get(spec.metric);
-            let _ = write!(
-                page,
-                "<td data-v=\"{}\">{}</td>",
-                value.map_or(String::new(), sort_value),
-                escape(&spec.format.apply(value))
-            );
-        }
-        let _ = writeln!(
-            page,
-            "<td>{}</td></tr>",
-            r.self_intersecting.map_or("not checked", |b| if b { "yes" } else { "no" }),
+            cells,
+            "<td data-v=\"{}\">{}</td>",
+            value.map_or(String::new(), sort_value),
+            escape(&spec.format.apply(value))
         );
     }
-    page.push_str("</tbody></table></div>\n");
+    cells
 }
 
 /// The 3D view (filled by `viewer.js` when a row is clicked).
@@ -466,10 +474,9 @@ fn input_notes(page: &mut String, context: &PageContext) {
 
 /// Our arap against libigl's (`peers.md`).
 fn arap_against_libigl(page: &mut String, context: &PageContext) {
-    let peers = context.peers;
-    if !peers.is_empty() {
+    if !context.peers.rows.is_empty() {
         page.push_str("<h2 id=\"arap-libigl\">Our arap against libigl's</h2>\n");
-        page.push_str(&markdown_table(peers));
+        page.push_str(&render::table(context.peers));
     }
 }
 
@@ -528,38 +535,33 @@ fn below_the_reference(page: &mut String, context: &PageContext) {
 
 /// The rendered result grids.
 fn rendered_results(page: &mut String, context: &PageContext) {
-    let grids = context.images(ImageGroup::Grid);
+    let grids = context.figures(&ImageGroup::Grid);
     if !grids.is_empty() {
         page.push_str("<h2 id=\"figures\">Rendered results</h2>\n");
-        for g in grids {
-            image(page, g, caption_for(g));
-        }
+        page.push_str(&grids);
     }
 }
 
 /// Every other plot.
 fn plots(page: &mut String, context: &PageContext) {
-    let plots = context.images(ImageGroup::Plot);
+    let plots = context.figures(&ImageGroup::Plot);
     if !plots.is_empty() {
         page.push_str("<h2 id=\"plots\">Plots</h2>\n");
-        for p in &plots {
-            image(page, p, caption_for(p));
-        }
+        page.push_str(&plots);
     }
 }
 
 /// HIRM's Table 1, when a scenario ran both of its sides.
 fn table1(page: &mut String, context: &PageContext) {
-    let table1_markdown = context.table1_markdown;
-    if table1_markdown.lines().filter(|l| l.starts_with('|')).count() > 2 {
+    if !context.table1.rows.is_empty() {
         page.push_str("<h2 id=\"table1\">Handle-set update (HIRM Table 1)</h2>\n");
-        page.push_str(&markdown_table(table1_markdown));
+        page.push_str(&render::table(context.table1));
     }
 }
 
 /// Every single render (rest shapes, results, heat maps), folded.
 fn every_render(page: &mut String, context: &PageContext) {
-    let single = context.images(ImageGroup::Render);
+    let single: Vec<&Image> = context.images(&ImageGroup::Render).collect();
     if !single.is_empty() {
         let _ = writeln!(
             page,
@@ -571,7 +573,7 @@ fn every_render(page: &mut String, context: &PageContext) {
             let _ = writeln!(
                 page,
                 "<img src=\"{u}\" alt=\"{u}\" title=\"{u}\" loading=\"eager\" style=\"max-width:240px\">",
-                u = escape(&link(p)),
+                u = escape(&link(&p.path)),
             );
         }
         page.push_str("</details>\n");
@@ -608,9 +610,7 @@ fn scripts(page: &mut String, _: &PageContext) {
 
 /// "Quality against time": per test with sweep points its plot, budget table, fronts and points.
 fn quality_against_time(page: &mut String, context: &PageContext) {
-    use crate::report::quality_time;
-    let (results, plots) = (context.results, context.images(ImageGroup::Pareto));
-    let scenarios = quality_time::swept_scenarios(results);
+    let scenarios = super::quality_time::swept_scenarios(context.results);
     if scenarios.is_empty() {
         return;
     }
@@ -622,29 +622,24 @@ fn quality_against_time(page: &mut String, context: &PageContext) {
          the <code>ok</code> setting with the lowest error within it.</p>\n",
     );
     for scenario in scenarios {
-        let cases: Vec<&CaseResult> = results.iter().filter(|r| r.scenario == scenario).collect();
-        let _ = writeln!(page, "<h3 id=\"quality-time-{s}\">{s}</h3>", s = escape(scenario));
-        if let Some(p) = plots.iter().find(|p| caption_for(p) == format!("{scenario}-pareto")) {
-            image(page, p, format!("{scenario}: quality against time"));
-        }
-        page.push_str(&markdown_table(&quality_time::budget_table(&cases)));
-        for m in crate::pareto::MEASURES {
-            let _ = writeln!(
-                page,
-                "<p>Front of {} against the time per edit: {}</p>",
-                escape(m.spec().label),
-                escape(&quality_time::front_list(&cases, m))
-            );
-        }
-        let _ = writeln!(
-            page,
-            "<details><summary>Every point of {} ({})</summary>",
-            escape(scenario),
-            cases.len()
-        );
-        page.push_str(&markdown_table(&quality_time::points_table(&cases)));
-        page.push_str("</details>\n");
+        quality_against_time_of(page, context, scenario);
     }
+}
+
+/// Quality against time on one test: its plot, budget table and fronts, and every point folded.
+fn quality_against_time_of(page: &mut String, context: &PageContext, scenario: &str) {
+    use super::quality_time::{budget_table, front, points_table};
+    let cases: Vec<&CaseResult> = context.results.iter().filter(|r| r.scenario == scenario).collect();
+    let _ = writeln!(page, "<h3 id=\"quality-time-{s}\">{s}</h3>", s = escape(scenario));
+    page.push_str(&context.figures(&ImageGroup::QualityTime(scenario.to_string())));
+    page.push_str(&render::table(&budget_table(&cases)));
+    for m in crate::pareto::MEASURES {
+        page.push_str(&render::block(&Block::Paragraph(front(&cases, m))));
+    }
+    let _ =
+        writeln!(page, "<details><summary>Every point of {} ({})</summary>", escape(scenario), cases.len());
+    page.push_str(&render::table(&points_table(&cases)));
+    page.push_str("</details>\n");
 }
 
 /// A timing cell (`<td>`, sorted by its value): the value, and below it the min–max range when it
@@ -692,28 +687,6 @@ fn answer_first(page: &mut String, _: &PageContext) {
     );
 }
 
-/// A path relative to the report directory as a URL path (forward slashes).
-fn link(path: &Path) -> String {
-    path.components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect::<Vec<_>>().join("/")
-}
-
-fn caption_for(path: &Path) -> String {
-    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
-}
-
-fn image(page: &mut String, path: &Path, caption: String) {
-    let url = link(path);
-    let svg = path.with_extension("svg");
-    let _ = writeln!(
-        page,
-        "<figure><a href=\"{u}\"><img src=\"{u}\" alt=\"{c}\" loading=\"eager\"></a><figcaption>{c} \
-         (<a href=\"{s}\">SVG</a>)</figcaption></figure>",
-        u = escape(&url),
-        c = escape(&caption),
-        s = escape(&link(&svg)),
-    );
-}
-
 /// The data attributes of a collection's case for the page's filters: its edit family and mesh,
 /// and from the mesh's manifest row whether it is closed, its genus (0, 1, 2-4, 5+) and size class
 /// (by vertices: < 5K, 5-30K, 30-100K, >= 100K); nothing for other cases.
@@ -744,78 +717,9 @@ fn member_attributes(case: &CaseResult) -> String {
     out
 }
 
-/// The pipe tables of `markdown` as HTML tables; other lines as paragraphs.
-fn markdown_table(markdown: &str) -> String {
-    let mut out = String::new();
-    let mut in_table = false;
-    let mut header = true;
-    for line in markdown.lines() {
-        let line = line.trim();
-        if line.starts_with('|') {
-            let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
-            if cells.iter().all(|c| c.chars().all(|ch| ch == '-' || ch == ':')) {
-                continue;
-            }
-            if !in_table {
-                out.push_str("<table>\n");
-                in_table = true;
-                header = true;
-            }
-            let tag = if header { "th" } else { "td" };
-            out.push_str("<tr>");
-            for c in cells {
-                let _ = write!(out, "<{tag}>{}</{tag}>", escape(c));
-            }
-            out.push_str("</tr>\n");
-            header = false;
-        } else {
-            if in_table {
-                out.push_str("</table>\n");
-                in_table = false;
-            }
-            if !line.is_empty() && !line.starts_with('#') {
-                let _ = writeln!(out, "<p>{}</p>", inline_code(&escape(line)));
-            }
-        }
-    }
-    if in_table {
-        out.push_str("</table>\n");
-    }
-    out
-}
-
-/// Markdown's `code` spans as `<code>` (an unpaired backtick stays).
-fn inline_code(text: &str) -> String {
-    let parts: Vec<&str> = text.split('`').collect();
-    if parts.len() % 2 == 0 {
-        return text.to_string();
-    }
-    let mut out = String::new();
-    for (i, part) in parts.iter().enumerate() {
-        if i % 2 == 1 {
-            let _ = write!(out, "<code>{part}</code>");
-        } else {
-            out.push_str(part);
-        }
-    }
-    out
-}
-
 /// Write `index.html` under `dir` atomically.
 pub fn write_index(dir: &Path, page: &str) -> Result<PathBuf, HarnessError> {
     let path = dir.join("index.html");
     meshes::io::atomic_write(&path, |w| w.write_all(page.as_bytes()).map_err(meshes::MeshError::from))?;
     Ok(path)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn code_spans_become_code_elements() {
-        assert_eq!(inline_code("a `b` c `d`"), "a <code>b</code> c <code>d</code>");
-        assert_eq!(inline_code("one ` tick"), "one ` tick");
-        assert_eq!(markdown_table("see `x`\n"), "<p>see <code>x</code></p>\n");
-    }
 }

@@ -5,8 +5,7 @@
 //! table gives the distances and the ratio of the times to convergence. Written as `peers.md` and
 //! on the page.
 
-use std::fmt::Write as _;
-
+use super::document::{Column, Document, Table, Text};
 use crate::record::CaseResult;
 use crate::record::{LIKE_FOR_LIKE_REFERENCE, PEER_OF_REFERENCE, REFERENCE_METHOD};
 use crate::scenario::LoadedScenario;
@@ -93,51 +92,92 @@ pub fn arap_against_libigl(results: &[CaseResult], scenarios: &[LoadedScenario])
         .collect()
 }
 
-/// The rows as a markdown table (empty when there are none).
-pub fn render_markdown(rows: &[ArapAgainstLibigl]) -> String {
-    if rows.is_empty() {
-        return String::new();
-    }
-    let mut out = format!(
-        "# Our ARAP against libigl's\n\nAll three run the spokes energy until the estimated distance to the fixed point \
-         is below 1e-5 of the rest diagonal (ours by L-BFGS, libigl's plain local/global iteration one iteration per \
-         call). `{REFERENCE_METHOD}` has our default weights (intrinsic Delaunay cotangents), \
-         `{LIKE_FOR_LIKE_REFERENCE}` libigl's (plain cotangents): the like-for-like comparison. Time = bind + solve of \
-         every edit step (libigl's `arap_precomputation` needs the handles, so it is bind); ratio = ours / libigl's, \
-         below 1 ours is faster. Distance = RMS of libigl's result from ours / rest diagonal. A `*` marks a row \
-         stopped at its iteration cap.\n\n\
-         | test | #V | libigl iterations | libigl s | {REFERENCE_METHOD} iterations | s | ratio | distance | \
-         {LIKE_FOR_LIKE_REFERENCE} iterations | s | ratio | distance |\n\
-         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n"
+/// The rows as a table (no rows: no test had both ARAPs).
+pub fn table(rows: &[ArapAgainstLibigl]) -> Table {
+    let mut header = vec![Column::left("test")];
+    let titles = ["#V", "libigl iterations", "libigl s"].map(String::from).into_iter().chain(
+        [REFERENCE_METHOD, LIKE_FOR_LIKE_REFERENCE]
+            .into_iter()
+            .flat_map(|m| [format!("{m} iterations"), "s".into(), "ratio".into(), "distance".into()]),
     );
-    let cap = |converged: bool| if converged { "" } else { "*" };
-    // This table is printed at the end of a run too: no `NaN` there.
-    let number = |v: f64, text: String| if v.is_finite() { text } else { "–".to_string() };
-    let side = |s: Option<&Side>| match s {
-        Some(s) => format!(
-            "{}{} | {} | {} | {}",
-            s.iterations,
-            cap(s.converged),
+    header.extend(titles.map(Column::right));
+    let mut table = Table::with_columns(header).captioned(caption());
+    for r in rows {
+        let mut cells = vec![
+            r.scenario.clone(),
+            r.vertices.to_string(),
+            format!("{}{}", r.libigl_iterations, cap(r.libigl_converged)),
+            number(r.libigl_s, format!("{:.3}", r.libigl_s)),
+        ];
+        cells.extend(side_cells(Some(&r.ours)));
+        cells.extend(side_cells(r.like_for_like.as_ref()));
+        table.push_row(cells);
+    }
+    table
+}
+
+/// What the table's columns are, above it.
+fn caption() -> Text {
+    Text::plain(
+        "All three run the spokes energy until the estimated distance to the fixed point is below 1e-5 of the \
+         rest diagonal (ours by L-BFGS, libigl's plain local/global iteration one iteration per call). ",
+    )
+    .then_code(REFERENCE_METHOD)
+    .then(" has our default weights (intrinsic Delaunay cotangents), ")
+    .then_code(LIKE_FOR_LIKE_REFERENCE)
+    .then(
+        " libigl's (plain cotangents): the like-for-like comparison. Time = bind + solve of every edit step \
+         (libigl's ",
+    )
+    .then_code("arap_precomputation")
+    .then(
+        " needs the handles, so it is bind); ratio = ours / libigl's, below 1 ours is faster. Distance = RMS of \
+         libigl's result from ours / rest diagonal. A ",
+    )
+    .then_code("*")
+    .then(" marks a row stopped at its iteration cap.")
+}
+
+/// `*` for a row stopped at its iteration cap.
+fn cap(converged: bool) -> &'static str {
+    if converged {
+        ""
+    } else {
+        "*"
+    }
+}
+
+/// `text`, or `–` when `v` is not finite (the table is printed at the end of a run too: no `NaN`
+/// there).
+fn number(v: f64, text: String) -> String {
+    if v.is_finite() {
+        text
+    } else {
+        "–".to_string()
+    }
+}
+
+/// One of our ARAPs' cells: iterations, seconds, ratio, distance (`–` each for none).
+fn side_cells(side: Option<&Side>) -> [String; 4] {
+    match side {
+        Some(s) => [
+            format!("{}{}", s.iterations, cap(s.converged)),
             number(s.seconds, format!("{:.3}", s.seconds)),
             number(s.ratio, format!("{:.2}", s.ratio)),
-            number(s.rms_over_diag, format!("{:.1e}", s.rms_over_diag))
-        ),
-        None => "– | – | – | –".to_string(),
-    };
-    for r in rows {
-        let _ = writeln!(
-            out,
-            "| {} | {} | {}{} | {} | {} | {} |",
-            r.scenario,
-            r.vertices,
-            r.libigl_iterations,
-            cap(r.libigl_converged),
-            number(r.libigl_s, format!("{:.3}", r.libigl_s)),
-            side(Some(&r.ours)),
-            side(r.like_for_like.as_ref()),
-        );
+            number(s.rms_over_diag, format!("{:.1e}", s.rms_over_diag)),
+        ],
+        None => ["–", "–", "–", "–"].map(String::from),
     }
-    out
+}
+
+/// `peers.md`: the table under its title; empty without rows.
+pub fn document(table: &Table) -> Document {
+    let mut document = Document::default();
+    if !table.rows.is_empty() {
+        document.heading(1, "Our ARAP against libigl's");
+        document.table(table.clone());
+    }
+    document
 }
 
 #[cfg(test)]
@@ -155,12 +195,12 @@ mod tests {
             ours: Side { iterations: 200, seconds: 1.0, converged: true, ratio: 0.25, rms_over_diag: 2e-3 },
             like_for_like: None,
         }];
-        let md = render_markdown(&rows);
+        let md = document(&table(&rows)).to_markdown();
         assert!(
             md.contains("| bar | 10 | 2000 | 4.000 | 200 | 1.000 | 0.25 | 2.0e-3 | – | – | – | – |"),
             "{md}"
         );
-        assert!(render_markdown(&[]).is_empty());
+        assert!(document(&table(&[])).is_empty());
         assert_eq!(
             rms_distance(&[[0.0; 3], [3.0, 4.0, 0.0]], &[[0.0; 3], [0.0; 3]], 2.0),
             (12.5f64).sqrt() / 2.0

@@ -22,6 +22,7 @@ use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::document::{Image, ImageGroup};
 use crate::error::HarnessError;
 use crate::metrics::{MetricSpec, METRICS};
 use crate::record::CaseResult;
@@ -71,13 +72,41 @@ fn method_color(method: &str, cases: &[&CaseResult]) -> RGBColor {
     PALETTE[index % PALETTE.len()]
 }
 
-/// Write every plot of `results` under `dir/plots/`; returns the paths written relative to `dir`
-/// (PNG and SVG of each plot).
-pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, HarnessError> {
+/// Write every plot of `results` under `dir/plots/`, each as PNG and SVG; returns the PNGs, their
+/// paths relative to `dir`, in the page's groups.
+pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<Image>, HarnessError> {
     crate::report::fonts::register_sans_serif()?;
     let plot_dir = dir.join("plots");
     std::fs::create_dir_all(&plot_dir).map_err(|error| HarnessError::Io { path: plot_dir.clone(), error })?;
-    let mut written = Vec::new();
+    let mut written = scenario_plots(dir, results)?;
+    let sweeps: Vec<&CaseResult> =
+        results.iter().filter(|r| r.scenario.contains("-sweep-") && !r.status.is_failed()).collect();
+    if !sweeps.is_empty() {
+        written.push(save(dir, "scaling", ImageGroup::Plot, &Plot::Scaling(&sweeps))?);
+    }
+    let handle_scenarios: Vec<&CaseResult> = results
+        .iter()
+        .filter(|r| r.scenario.ends_with("-handles") && methods::registry::table1_side(&r.method).is_some())
+        .collect();
+    if !handle_scenarios.is_empty() {
+        written.push(save(dir, "table1", ImageGroup::Plot, &Plot::Table1(&handle_scenarios))?);
+    }
+    let dataset = crate::report::dataset::dataset_cases(results);
+    if !dataset.is_empty() {
+        written.push(save(dir, "dataset-ecdf", ImageGroup::Dataset, &Plot::DatasetEcdf(&dataset))?);
+        written.push(save(dir, "dataset-cost", ImageGroup::Dataset, &Plot::DatasetCost(&dataset))?);
+    }
+    let series: Vec<&CaseResult> =
+        crate::report::size_series::series_cases(results).into_values().flatten().collect();
+    if !series.is_empty() {
+        written.push(save(dir, "size-series", ImageGroup::SizeSeries, &Plot::SizeSeries(&series))?);
+    }
+    Ok(written)
+}
+
+/// The plots of each test that is not a collection's (those are summed up by the dataset plots):
+/// errors, timings, convergence, and quality against time when it has sweep points.
+fn scenario_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<Image>, HarnessError> {
     let mut scenarios: Vec<&str> = Vec::new();
     for r in results {
         if !scenarios.contains(&r.scenario.as_str()) {
@@ -85,38 +114,21 @@ pub fn write_plots(dir: &Path, results: &[CaseResult]) -> Result<Vec<PathBuf>, H
         }
     }
     let swept = crate::report::quality_time::swept_scenarios(results);
-    // A collection's cases are summed up by the dataset plots below, not one plot set per mesh.
     scenarios.retain(|s| results.iter().any(|r| r.scenario == *s && r.member.is_none()));
+    let mut written = Vec::new();
     for scenario in scenarios {
         let cases: Vec<&CaseResult> = results.iter().filter(|r| r.scenario == scenario).collect();
-        written.extend(save(dir, &format!("{scenario}-errors"), &Plot::Errors(scenario, &cases))?);
-        written.extend(save(dir, &format!("{scenario}-timings"), &Plot::Timings(scenario, &cases))?);
-        written.extend(save(dir, &format!("{scenario}-convergence"), &Plot::Convergence(scenario, &cases))?);
+        let plot = |stem: &str, plot: Plot| save(dir, &format!("{scenario}-{stem}"), ImageGroup::Plot, &plot);
+        written.push(plot("errors", Plot::Errors(scenario, &cases))?);
+        written.push(plot("timings", Plot::Timings(scenario, &cases))?);
+        written.push(plot("convergence", Plot::Convergence(scenario, &cases))?);
         if swept.contains(&scenario) {
-            written.extend(save(dir, &format!("{scenario}-pareto"), &Plot::Pareto(scenario, &cases))?);
+            let group = ImageGroup::QualityTime(scenario.to_string());
+            let mut pareto =
+                save(dir, &format!("{scenario}-pareto"), group, &Plot::Pareto(scenario, &cases))?;
+            pareto.caption = format!("{scenario}: quality against time");
+            written.push(pareto);
         }
-    }
-    let sweeps: Vec<&CaseResult> =
-        results.iter().filter(|r| r.scenario.contains("-sweep-") && !r.status.is_failed()).collect();
-    if !sweeps.is_empty() {
-        written.extend(save(dir, "scaling", &Plot::Scaling(&sweeps))?);
-    }
-    let handle_scenarios: Vec<&CaseResult> = results
-        .iter()
-        .filter(|r| r.scenario.ends_with("-handles") && methods::registry::table1_side(&r.method).is_some())
-        .collect();
-    if !handle_scenarios.is_empty() {
-        written.extend(save(dir, "table1", &Plot::Table1(&handle_scenarios))?);
-    }
-    let dataset = crate::report::dataset::dataset_cases(results);
-    if !dataset.is_empty() {
-        written.extend(save(dir, "dataset-ecdf", &Plot::DatasetEcdf(&dataset))?);
-        written.extend(save(dir, "dataset-cost", &Plot::DatasetCost(&dataset))?);
-    }
-    let series: Vec<&CaseResult> =
-        crate::report::size_series::series_cases(results).into_values().flatten().collect();
-    if !series.is_empty() {
-        written.extend(save(dir, "size-series", &Plot::SizeSeries(&series))?);
     }
     Ok(written)
 }
@@ -168,8 +180,9 @@ impl Plot<'_> {
     }
 }
 
-/// Draw `plot` into `plots/<stem>.png` and `.svg` under `dir`; returns both relative paths.
-fn save(dir: &Path, stem: &str, plot: &Plot<'_>) -> Result<Vec<PathBuf>, HarnessError> {
+/// Draw `plot` into `plots/<stem>.png` and `.svg` under `dir`; returns the PNG in `group`, captioned
+/// by its stem.
+fn save(dir: &Path, stem: &str, group: ImageGroup, plot: &Plot<'_>) -> Result<Image, HarnessError> {
     let png = PathBuf::from("plots").join(format!("{stem}.png"));
     let svg = PathBuf::from("plots").join(format!("{stem}.svg"));
     let fail = |path: &Path, message: String| HarnessError::Report(format!("{}: {message}", path.display()));
@@ -193,7 +206,7 @@ fn save(dir: &Path, stem: &str, plot: &Plot<'_>) -> Result<Vec<PathBuf>, Harness
     }
     let final_svg = dir.join(&svg);
     meshes::io::atomic_write(&final_svg, |w| w.write_all(text.as_bytes()).map_err(meshes::MeshError::from))?;
-    Ok(vec![png, svg])
+    Ok(Image { group, path: png, caption: stem.to_string() })
 }
 
 fn err<E: std::fmt::Display>(e: E) -> String {
@@ -885,6 +898,20 @@ fn draw_pareto<DB: DrawingBackend>(root: Area<'_, DB>, scenario: &str, cases: &[
     Ok(())
 }
 
+/// A chart with log axes for time and error.
+type LogLogChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
+/// Log axes need positive values: a time or error of 0 sits at the axis' floor.
+const LOG_FLOOR: f64 = 1e-6;
+
+/// Where a point sits on the log axes: its time and error, floored at [`LOG_FLOOR`].
+fn on_log_axes(p: &crate::pareto::Point) -> (f64, f64) {
+    (p.time.max(LOG_FLOOR), p.error.max(LOG_FLOOR))
+}
+
+/// One panel of [`draw_pareto`]: `measure` against the time `axis`, each sweep a line, the front a
+/// staircase with its settings named, the points in their base method's colour (suspect ones
+/// crossed); the first panel (`legend`) carries the legend.
 fn draw_pareto_panel<DB: DrawingBackend>(
     root: &Area<'_, DB>,
     cases: &[&CaseResult],
@@ -892,18 +919,33 @@ fn draw_pareto_panel<DB: DrawingBackend>(
     axis: crate::pareto::TimeAxis,
     legend: bool,
 ) -> DrawResult {
-    use crate::pareto::{ok_front, points};
-    // Log axes need positive values: a time or error of 0 sits at the axis' floor.
-    const FLOOR: f64 = 1e-6;
-    let placed = points(cases, axis, measure);
+    let placed = crate::pareto::points(cases, axis, measure);
     if placed.is_empty() {
         return Ok(());
     }
-    let xy = |p: &crate::pareto::Point| (p.time.max(FLOOR), p.error.max(FLOOR));
-    let (x0, x1) =
-        placed.iter().fold((f64::INFINITY, 0.0f64), |(a, b), (_, p)| (a.min(xy(p).0), b.max(xy(p).0)));
-    let (y0, y1) =
-        placed.iter().fold((f64::INFINITY, 0.0f64), |(a, b), (_, p)| (a.min(xy(p).1), b.max(xy(p).1)));
+    let at: Vec<(f64, f64)> = placed.iter().map(|(_, p)| on_log_axes(p)).collect();
+    let x_end = at.iter().fold(0.0f64, |b, p| b.max(p.0)) * 1.7;
+    let mut chart = pareto_chart(root, &at, measure, axis)?;
+    draw_sweep_lines(&mut chart, &placed, &at, cases)?;
+    let front = crate::pareto::ok_front(&placed);
+    draw_front_staircase(&mut chart, &front, &at, x_end)?;
+    draw_pareto_points(&mut chart, &placed, &at, cases, legend)?;
+    name_front_points(&mut chart, &placed, &front, &at)?;
+    if legend {
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 13)?;
+    }
+    Ok(())
+}
+
+/// The panel's chart: log axes around the points `at`, with their caption, labels and grid.
+fn pareto_chart<'a, DB: DrawingBackend>(
+    root: &Area<'a, DB>,
+    at: &[(f64, f64)],
+    measure: crate::metrics::Metric,
+    axis: crate::pareto::TimeAxis,
+) -> Result<LogLogChart<'a, DB>, String> {
+    let (x0, x1) = at.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let (y0, y1) = at.iter().fold((f64::INFINITY, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
     let spec = measure.spec();
     let unit = if spec.unit.is_empty() { String::new() } else { format!(" ({})", spec.unit) };
     let mut chart = ChartBuilder::on(root)
@@ -924,10 +966,18 @@ fn draw_pareto_panel<DB: DrawingBackend>(
         .label_style(("sans-serif", 13))
         .draw()
         .map_err(err)?;
+    Ok(chart)
+}
 
-    // Each sweep's points in parameter order, in its base method's colour.
+/// Each sweep's points (placed at `at`) joined in parameter order, in its base method's colour.
+fn draw_sweep_lines<DB: DrawingBackend>(
+    chart: &mut LogLogChart<'_, DB>,
+    placed: &[(&CaseResult, crate::pareto::Point)],
+    at: &[(f64, f64)],
+    cases: &[&CaseResult],
+) -> DrawResult {
     let mut sweeps: Vec<&str> = Vec::new();
-    for (c, _) in &placed {
+    for (c, _) in placed {
         for p in &c.sweeps {
             if !sweeps.contains(&p.sweep.as_str()) {
                 sweeps.push(&p.sweep);
@@ -937,7 +987,10 @@ fn draw_pareto_panel<DB: DrawingBackend>(
     for sweep in sweeps {
         let mut line: Vec<(usize, &CaseResult, (f64, f64))> = placed
             .iter()
-            .filter_map(|(c, p)| c.sweeps.iter().find(|s| s.sweep == sweep).map(|s| (s.position, *c, xy(p))))
+            .zip(at)
+            .filter_map(|((c, _), &xy)| {
+                c.sweeps.iter().find(|s| s.sweep == sweep).map(|s| (s.position, *c, xy))
+            })
             .collect();
         line.sort_by_key(|(position, _, _)| *position);
         let Some((_, first, _)) = line.first() else { continue };
@@ -946,27 +999,45 @@ fn draw_pareto_panel<DB: DrawingBackend>(
             .draw_series(LineSeries::new(line.iter().map(|(_, _, p)| *p), color.mix(0.6).stroke_width(1)))
             .map_err(err)?;
     }
-    // The front of the ok points: a staircase through them, fastest first.
-    let on = ok_front(&placed);
+    Ok(())
+}
+
+/// The front of the `ok` points (`front`, fastest first): a black staircase through them, on to
+/// `x_end`.
+fn draw_front_staircase<DB: DrawingBackend>(
+    chart: &mut LogLogChart<'_, DB>,
+    front: &[usize],
+    at: &[(f64, f64)],
+    x_end: f64,
+) -> DrawResult {
     let mut stairs: Vec<(f64, f64)> = Vec::new();
-    for &i in &on {
-        let (x, y) = xy(&placed[i].1);
+    for &i in front {
+        let (x, y) = at[i];
         if let Some(&(_, last_y)) = stairs.last() {
             stairs.push((x, last_y));
         }
         stairs.push((x, y));
     }
     if let Some(&(_, y)) = stairs.last() {
-        stairs.push((x1 * 1.7, y));
+        stairs.push((x_end, y));
     }
     chart.draw_series(LineSeries::new(stairs, BLACK.stroke_width(2))).map_err(err)?;
+    Ok(())
+}
 
-    // The points: one legend entry per base method.
+/// The points in their base method's colour, suspect ones crossed; with `legend`, one legend entry
+/// per base method.
+fn draw_pareto_points<DB: DrawingBackend>(
+    chart: &mut LogLogChart<'_, DB>,
+    placed: &[(&CaseResult, crate::pareto::Point)],
+    at: &[(f64, f64)],
+    cases: &[&CaseResult],
+    legend: bool,
+) -> DrawResult {
     let mut labelled: Vec<&str> = Vec::new();
-    for (c, p) in &placed {
+    for ((c, _), &at) in placed.iter().zip(at) {
         let base = crate::sweep::base_method(&c.method);
         let color = method_color(base, cases);
-        let at = xy(p);
         let series = chart.draw_series(std::iter::once(Circle::new(at, 5, color.filled()))).map_err(err)?;
         if legend && !labelled.contains(&base) {
             labelled.push(base);
@@ -978,19 +1049,20 @@ fn draw_pareto_panel<DB: DrawingBackend>(
                 .map_err(err)?;
         }
     }
-    // The front's points by name, so a reader can tell which setting it is.
-    for &i in &on {
-        let (c, p) = &placed[i];
-        chart
-            .draw_series(std::iter::once(Text::new(
-                format!(" {}", c.method),
-                xy(p),
-                ("sans-serif", 12).into_font().color(&BLACK),
-            )))
-            .map_err(err)?;
-    }
-    if legend {
-        draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 13)?;
+    Ok(())
+}
+
+/// The front's points by name, so a reader can tell which setting each is.
+fn name_front_points<DB: DrawingBackend>(
+    chart: &mut LogLogChart<'_, DB>,
+    placed: &[(&CaseResult, crate::pareto::Point)],
+    front: &[usize],
+    at: &[(f64, f64)],
+) -> DrawResult {
+    for &i in front {
+        let name = format!(" {}", placed[i].0.method);
+        let font = ("sans-serif", 12).into_font().color(&BLACK);
+        chart.draw_series(std::iter::once(Text::new(name, at[i], font))).map_err(err)?;
     }
     Ok(())
 }

@@ -3,9 +3,9 @@
 //! the lowest error, per measure of [`MEASURES`]), the front of each measure against the time per
 //! edit, and every point with its parameters, times, measures and status.
 
-use std::fmt::Write as _;
 use std::path::Path;
 
+use super::document::{write_text, Document, Table, Text};
 use crate::pareto::{best_within, budget_label, ok_front, points, TimeAxis, BUDGETS_S, MEASURES};
 use crate::record::CaseResult;
 
@@ -57,16 +57,11 @@ fn seconds_text(s: f64) -> String {
     }
 }
 
-/// The budget table of one test (markdown): a row per budget, a column per measure, each cell the
-/// best `ok` case within the budget per edit, its value and its time.
-pub fn budget_table(cases: &[&CaseResult]) -> String {
-    let mut md = String::from("| budget per edit |");
-    for m in MEASURES {
-        let _ = write!(md, " best by {} |", m.spec().label);
-    }
-    md.push('\n');
-    md.push_str(&"|---".repeat(MEASURES.len() + 1));
-    md.push_str("|\n");
+/// The budget table of one test: a row per budget, a column per measure, each cell the best `ok`
+/// case within the budget per edit, its value and its time.
+pub fn budget_table(cases: &[&CaseResult]) -> Table {
+    let titles = MEASURES.iter().map(|m| format!("best by {}", m.spec().label));
+    let mut table = Table::new(std::iter::once("budget per edit".to_string()).chain(titles));
     // Per measure: the placed cases, their points and which are `ok`.
     let placed: Vec<_> = MEASURES
         .iter()
@@ -78,25 +73,20 @@ pub fn budget_table(cases: &[&CaseResult]) -> String {
         })
         .collect();
     for budget in BUDGETS_S {
-        let _ = write!(md, "| {} |", budget_label(budget));
-        for (measure, placed, coordinates, ok) in &placed {
-            let measure = *measure;
+        let best = placed.iter().map(|(measure, placed, coordinates, ok)| {
             match best_within(coordinates, ok, budget) {
-                Some(i) => {
-                    let _ = write!(
-                        md,
-                        " {}: {}, {} |",
-                        placed[i].0.method,
-                        value_text(measure, coordinates[i].error),
-                        seconds_text(coordinates[i].time)
-                    );
-                }
-                None => md.push_str(" none ok within it |"),
+                Some(i) => format!(
+                    "{}: {}, {}",
+                    placed[i].0.method,
+                    value_text(*measure, coordinates[i].error),
+                    seconds_text(coordinates[i].time)
+                ),
+                None => "none ok within it".to_string(),
             }
-        }
-        md.push('\n');
+        });
+        table.push_row(std::iter::once(budget_label(budget)).chain(best));
     }
-    md
+    table
 }
 
 /// The front of the `ok` cases by `measure` against the time per edit (one line, fastest first).
@@ -112,65 +102,67 @@ pub fn front_list(cases: &[&CaseResult], measure: crate::metrics::Metric) -> Str
         .join("; ")
 }
 
-/// Every case of one test as a point (markdown table): its sweeps and values, both times, the
-/// measures, the status.
-pub fn points_table(cases: &[&CaseResult]) -> String {
-    let mut md = String::from("| method | sweep: values | per edit | with precompute |");
-    for m in MEASURES {
-        let _ = write!(md, " {} |", m.spec().label);
-    }
-    md.push_str(" status |\n");
-    md.push_str(&"|---".repeat(MEASURES.len() + 5));
-    md.push_str("|\n");
+/// "Front of `measure` against the time per edit: " and its [`front_list`].
+pub fn front(cases: &[&CaseResult], measure: crate::metrics::Metric) -> Text {
+    Text::plain(format!(
+        "Front of {} against the time per edit: {}",
+        measure.spec().label,
+        front_list(cases, measure)
+    ))
+}
+
+/// Every case of one test as a point: its sweeps and values, both times, the measures, the status.
+pub fn points_table(cases: &[&CaseResult]) -> Table {
+    let titles = ["method", "sweep: values", "per edit", "with precompute"].map(String::from).into_iter();
+    let measures = MEASURES.iter().map(|m| m.spec().label.to_string());
+    let mut table = Table::new(titles.chain(measures).chain(["status".to_string()]));
     for c in cases {
         let sweeps =
             c.sweeps.iter().map(|p| format!("{}: {}", p.sweep, p.values)).collect::<Vec<_>>().join("; ");
-        let _ = write!(
-            md,
-            "| {} | {} | {} | {} |",
-            c.method,
+        let mut cells = vec![
+            c.method.clone(),
             if sweeps.is_empty() { "–".to_string() } else { sweeps },
             seconds_text(TimeAxis::Edit.seconds(c)),
-            seconds_text(TimeAxis::WithPrecompute.seconds(c))
-        );
-        for m in MEASURES {
-            let _ = write!(md, " {} |", m.spec().format.apply(c.quality.get(m)));
-        }
-        let _ = writeln!(md, " {} |", c.status.kind());
+            seconds_text(TimeAxis::WithPrecompute.seconds(c)),
+        ];
+        cells.extend(MEASURES.iter().map(|&m| m.spec().format.apply(c.quality.get(m))));
+        cells.push(c.status.kind().to_string());
+        table.push_row(cells);
     }
-    md
+    table
 }
 
 /// `pareto.md`: per swept test its budget table, fronts and points (empty without sweep points).
-pub fn render_markdown(results: &[CaseResult]) -> String {
-    let mut md = String::new();
-    for scenario in swept_scenarios(results) {
-        let cases: Vec<&CaseResult> = results.iter().filter(|r| r.scenario == scenario).collect();
-        let _ = writeln!(md, "## {scenario}\n\nThe `ok` case with the lowest error within each time per edit (bind + solve):\n");
-        md.push_str(&budget_table(&cases));
-        md.push('\n');
-        for m in MEASURES {
-            let _ = writeln!(
-                md,
-                "Front of {} against the time per edit: {}\n",
-                m.spec().label,
-                front_list(&cases, m)
-            );
-        }
-        md.push_str(&points_table(&cases));
-        md.push('\n');
+pub fn document(results: &[CaseResult]) -> Document {
+    let mut document = Document::default();
+    let scenarios = swept_scenarios(results);
+    if scenarios.is_empty() {
+        return document;
     }
-    md
+    document.heading(1, "Quality against time");
+    for scenario in scenarios {
+        let cases: Vec<&CaseResult> = results.iter().filter(|r| r.scenario == scenario).collect();
+        document.heading(2, scenario);
+        document.paragraph(
+            Text::plain("The ")
+                .then_code("ok")
+                .then(" case with the lowest error within each time per edit (bind + solve):"),
+        );
+        document.table(budget_table(&cases));
+        for m in MEASURES {
+            document.paragraph(front(&cases, m));
+        }
+        document.table(points_table(&cases));
+    }
+    document
 }
 
 /// Write `pareto.md` under `dir` (atomically) when `results` have a swept test.
 pub fn write_markdown(dir: &Path, results: &[CaseResult]) -> Result<(), crate::error::HarnessError> {
-    let markdown = render_markdown(results);
-    if !markdown.is_empty() {
-        let text = format!("# Quality against time\n\n{markdown}");
-        meshes::io::atomic_write(dir.join("pareto.md"), |w| {
-            w.write_all(text.as_bytes()).map_err(meshes::MeshError::from)
-        })?;
+    let document = document(results);
+    if !document.is_empty() {
+        // pareto.md has always ended in a blank line after its last table.
+        write_text(&dir.join("pareto.md"), &format!("{}\n", document.to_markdown()))?;
     }
     Ok(())
 }

@@ -7,8 +7,8 @@
 //! a real shape's growth reads beside the procedural bar's. The plot is `plots/size-series`.
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 
+use super::document::{Column, Document, Table, Text};
 use crate::record::CaseResult;
 use crate::scenario::LoadedScenario;
 
@@ -37,69 +37,92 @@ pub fn series_cases(results: &[CaseResult]) -> BTreeMap<&str, Vec<&CaseResult>> 
 
 /// `size-series.md` for the series of `results`; the methods each scenario of a series left out
 /// (its `left_out`) are rows too. Empty when the run has no series of two sizes or more.
-pub fn render_markdown(results: &[CaseResult], scenarios: &[LoadedScenario]) -> String {
+pub fn document(results: &[CaseResult], scenarios: &[LoadedScenario]) -> Document {
+    let mut document = Document::default();
     let series = series_cases(results);
     if series.is_empty() {
-        return String::new();
+        return document;
     }
-    let mut md = String::from(
-        "# Cost against size\n\nOne shape at several sizes (scenarios sharing `series`): each case's time per phase, \
-         iterations, peak memory (what the method added; 0 when the allocator reused memory) and status, then \
-         each method's fitted slope of log cost against log #V (least squares over the sizes that ran; – for \
-         fewer than three).\n",
+    document.heading(1, "Cost against size");
+    document.paragraph(
+        Text::plain("One shape at several sizes (scenarios sharing ")
+            .then_code("series")
+            .then(
+                "): each case's time per phase, iterations, peak memory (what the method added; 0 when the \
+                 allocator reused memory) and status, then each method's fitted slope of log cost against log #V \
+                 (least squares over the sizes that ran; – for fewer than three).",
+            ),
     );
     for (name, cases) in &series {
-        let mut sizes: Vec<(usize, &str)> = cases.iter().map(|c| (c.vertices, c.scenario.as_str())).collect();
-        sizes.sort();
-        sizes.dedup();
         let methods = crate::report::dataset::methods_of(cases);
-        let _ = writeln!(md, "\n## {name}\n");
-        md.push_str(
-            "| method | scenario | #V | precompute | bind | solve | iterations | peak memory | status |\n",
-        );
-        md.push_str("|---|---|---:|---:|---:|---:|---:|---:|---|\n");
-        for m in &methods {
-            for (vertices, scenario) in &sizes {
-                if let Some(c) = cases.iter().find(|c| c.method == *m && c.scenario == *scenario) {
-                    let _ = writeln!(
-                        md,
-                        "| {m} | {scenario} | {vertices} | {} | {} | {} | {} | {} | {} |",
-                        seconds(c.precompute_s),
-                        seconds(c.bind_s),
-                        seconds(c.solve_s),
-                        c.iterations,
-                        mebibytes(c.peak_memory_mib),
-                        c.status
-                    );
-                } else if let Some(why) = left_out(scenarios, scenario, m) {
-                    let _ = writeln!(
-                        md,
-                        "| {m} | {scenario} | {vertices} | – | – | – | – | – | left out: {why} |"
-                    );
-                }
+        document.heading(2, *name);
+        document.table(cases_table(cases, &methods, scenarios));
+        document.table(slopes_table(cases, &methods));
+    }
+    document
+}
+
+/// Every case of one series, method by method from the smallest size up, with the methods a
+/// scenario left out and why.
+fn cases_table(cases: &[&CaseResult], methods: &[&str], scenarios: &[LoadedScenario]) -> Table {
+    let mut sizes: Vec<(usize, &str)> = cases.iter().map(|c| (c.vertices, c.scenario.as_str())).collect();
+    sizes.sort();
+    sizes.dedup();
+    let (left, right) = (Column::left, Column::right);
+    let mut table = Table::with_columns(vec![
+        left("method"),
+        left("scenario"),
+        right("#V"),
+        right("precompute"),
+        right("bind"),
+        right("solve"),
+        right("iterations"),
+        right("peak memory"),
+        left("status"),
+    ]);
+    for m in methods {
+        for (vertices, scenario) in &sizes {
+            let head = [m.to_string(), scenario.to_string(), vertices.to_string()];
+            if let Some(c) = cases.iter().find(|c| c.method == *m && c.scenario == *scenario) {
+                let measured = [
+                    seconds(c.precompute_s),
+                    seconds(c.bind_s),
+                    seconds(c.solve_s),
+                    c.iterations.to_string(),
+                    mebibytes(c.peak_memory_mib),
+                    c.status.to_string(),
+                ];
+                table.push_row(head.into_iter().chain(measured));
+            } else if let Some(why) = left_out(scenarios, scenario, m) {
+                let none = std::iter::repeat_n("–".to_string(), 5);
+                table.push_row(head.into_iter().chain(none).chain([format!("left out: {why}")]));
             }
-        }
-        md.push_str("\n| method |");
-        for (label, _) in SLOPE_QUANTITIES {
-            let _ = write!(md, " slope: {label} |");
-        }
-        md.push_str(" sizes |\n|---|");
-        md.push_str(&"---:|".repeat(SLOPE_QUANTITIES.len() + 1));
-        md.push('\n');
-        for m in &methods {
-            let ran: Vec<&&CaseResult> =
-                cases.iter().filter(|c| c.method == *m && !c.status.is_failed()).collect();
-            let _ = write!(md, "| {m} |");
-            for (_, quantity) in SLOPE_QUANTITIES {
-                let (slope, _) =
-                    crate::report::dataset::cost_slope(ran.iter().map(|c| (c.vertices, quantity(c))));
-                let _ =
-                    write!(md, " {} |", if slope.is_finite() { format!("{slope:.2}") } else { "–".into() });
-            }
-            let _ = writeln!(md, " {} |", ran.len());
         }
     }
-    md
+    table
+}
+
+/// Each method's fitted slopes of log cost against log #V over the sizes it ran.
+fn slopes_table(cases: &[&CaseResult], methods: &[&str]) -> Table {
+    let mut header = vec![Column::left("method")];
+    header.extend(SLOPE_QUANTITIES.iter().map(|(label, _)| Column::right(format!("slope: {label}"))));
+    header.push(Column::right("sizes"));
+    let mut table = Table::with_columns(header);
+    for m in methods {
+        let ran: Vec<&&CaseResult> =
+            cases.iter().filter(|c| c.method == *m && !c.status.is_failed()).collect();
+        let slopes = SLOPE_QUANTITIES.iter().map(|(_, quantity)| {
+            let (slope, _) =
+                crate::report::dataset::cost_slope(ran.iter().map(|c| (c.vertices, quantity(c))));
+            if slope.is_finite() {
+                format!("{slope:.2}")
+            } else {
+                "–".into()
+            }
+        });
+        table.push_row(std::iter::once(m.to_string()).chain(slopes).chain([ran.len().to_string()]));
+    }
+    table
 }
 
 /// Why `scenario` left `method` out, if it did.
@@ -129,14 +152,6 @@ fn mebibytes(m: f64) -> String {
     }
 }
 
-/// Write `markdown` to `dir/size-series.md` (atomically).
-pub fn write_markdown(dir: &std::path::Path, markdown: &str) -> Result<(), crate::error::HarnessError> {
-    meshes::io::atomic_write(dir.join("size-series.md"), |w| {
-        std::io::Write::write_all(w, markdown.as_bytes()).map_err(meshes::MeshError::from)
-    })
-    .map_err(crate::error::HarnessError::from)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -160,7 +175,7 @@ mod tests {
             .iter()
             .map(|&v| case(&format!("bar-{v}"), "arap", v, (v as f64).powf(1.5) * 1e-6))
             .collect();
-        let md = render_markdown(&results, &[]);
+        let md = document(&results, &[]).to_markdown();
         assert!(md.contains("## bar"), "{md}");
         assert!(md.contains("| arap | 1.50 | 0.00 | 1.50 | 1.00 | 3 |"), "{md}");
         assert!(md.contains("| arap | bar-100000 | 100000 |"), "{md}");
@@ -170,6 +185,6 @@ mod tests {
     fn one_size_is_no_series() {
         let results = vec![case("bar-a", "arap", 1_000, 1.0), case("bar-b", "hirm", 1_000, 1.0)];
         assert!(series_cases(&results).is_empty());
-        assert!(render_markdown(&results, &[]).is_empty());
+        assert!(document(&results, &[]).is_empty());
     }
 }

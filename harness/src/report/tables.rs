@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use super::document::{Document, Table, Text};
 use crate::error::HarnessError;
 use crate::metrics::METRICS;
 use crate::provenance::Provenance;
@@ -172,22 +173,37 @@ pub fn render_handle_updates(results: &[CaseResult]) -> Result<Vec<u8>, HarnessE
     w.into_inner().map_err(|e| HarnessError::Report(format!("CSV: {e}")))
 }
 
-/// `table1.md`: HIRM's Table 1 for every scenario that runs both of its sides
-/// ([`methods::registry::Table1Side`]; `hirm` and `isolines`): per step the number of handles, the
-/// handle-independent model's update `t_h` against the rebuild of the other (its whole
-/// `bind_handles`), their ratio `P`, and both per-iteration times.
-pub fn render_table1(results: &[CaseResult]) -> String {
+/// The two sides of HIRM's Table 1 ([`methods::registry::Table1Side`]): the handle-independent
+/// model and the one rebuilt per handle set (`hirm` and `isolines`).
+fn table1_methods() -> (&'static str, &'static str) {
     let name = |side| methods::registry::table1_method(side).map_or("-", |m| m.name);
-    let (hirm, isolines) = (name(Table1Side::HandleIndependent), name(Table1Side::Rebuilt));
-    let mut out = format!(
-        "# Handle-set update: `{hirm}` against the `{isolines}` rebuild (Wu et al. 2015, Table 1)\n\n\
-         t_h: {hirm}'s handle update (eq 26 and the factorization); rebuild: the whole bind of {isolines} \
-         (harmonic fields, isolines, reduced system). P = t_h / rebuild. t_i: median iteration.\n\n\
-         | scenario | step | n_h | n_field | n_t | t_e (s) | t_b (s) | t_h (ms) | rebuild (ms) | P (%) | t_i {hirm} (ms) | t_i {isolines} (ms) |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
-    );
-    let stat =
-        |r: &CaseResult, name: &str| phase(&r.statistics, name).map_or("-".to_string(), |v| format!("{v}"));
+    (name(Table1Side::HandleIndependent), name(Table1Side::Rebuilt))
+}
+
+/// HIRM's Table 1 for every scenario that runs both of its sides: per step the number of handles,
+/// the handle-independent model's update `t_h` against the rebuild of the other (its whole
+/// `bind_handles`), their ratio `P`, and both per-iteration times. No rows: no scenario ran both.
+pub fn table1(results: &[CaseResult]) -> Table {
+    let (hirm, isolines) = table1_methods();
+    let mut titles: Vec<String> = [
+        "scenario",
+        "step",
+        "n_h",
+        "n_field",
+        "n_t",
+        "t_e (s)",
+        "t_b (s)",
+        "t_h (ms)",
+        "rebuild (ms)",
+        "P (%)",
+    ]
+    .map(String::from)
+    .to_vec();
+    titles.extend([format!("t_i {hirm} (ms)"), format!("t_i {isolines} (ms)")]);
+    let mut table = Table::new(titles).captioned(format!(
+        "t_h: {hirm}'s handle update (eq 26 and the factorization); rebuild: the whole bind of {isolines} \
+         (harmonic fields, isolines, reduced system). P = t_h / rebuild. t_i: median iteration."
+    ));
     let side = |r: &CaseResult| methods::registry::table1_side(&r.method);
     for hirm in results.iter().filter(|r| side(r) == Some(Table1Side::HandleIndependent)) {
         let Some(isolines) =
@@ -196,29 +212,52 @@ pub fn render_table1(results: &[CaseResult]) -> String {
             continue;
         };
         for (h, i) in hirm.steps.iter().zip(&isolines.steps) {
-            let t_h = phase(&h.phase_timings, methods::keys::phase::T_H_HANDLE_UPDATE).unwrap_or(f64::NAN);
-            let t_e =
-                phase(&h.phase_timings, methods::keys::phase::T_E_PROPAGATION_FIELDS).unwrap_or(f64::NAN);
-            let t_b =
-                phase(&h.phase_timings, methods::keys::phase::T_B_BACKGROUND_PRECOMPUTE).unwrap_or(f64::NAN);
-            out.push_str(&format!(
-                "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.2} | {:.1} | {:.3} | {:.3} |\n",
-                hirm.scenario,
-                h.step,
-                h.handles,
-                stat(hirm, methods::keys::statistic::N_FIELD),
-                stat(hirm, methods::keys::statistic::N_T),
-                t_e,
-                t_b,
-                1e3 * t_h,
-                1e3 * i.bind_s,
-                100.0 * t_h / i.bind_s,
-                h.median_iteration_ms,
-                i.median_iteration_ms,
-            ));
+            table.push_row(table1_row(hirm, h, i));
         }
     }
-    out
+    table
+}
+
+/// One step of Table 1: `hirm`'s step `h` against the rebuild's step `i`.
+fn table1_row(
+    hirm: &CaseResult,
+    h: &crate::record::StepRecord,
+    i: &crate::record::StepRecord,
+) -> Vec<String> {
+    use methods::keys::{phase as key, statistic};
+    let stat = |name: &str| phase(&hirm.statistics, name).map_or("-".to_string(), |v| format!("{v}"));
+    let timing = |name: &str| phase(&h.phase_timings, name).unwrap_or(f64::NAN);
+    let t_h = timing(key::T_H_HANDLE_UPDATE);
+    vec![
+        hirm.scenario.clone(),
+        h.step.to_string(),
+        h.handles.to_string(),
+        stat(statistic::N_FIELD),
+        stat(statistic::N_T),
+        format!("{:.3}", timing(key::T_E_PROPAGATION_FIELDS)),
+        format!("{:.3}", timing(key::T_B_BACKGROUND_PRECOMPUTE)),
+        format!("{:.2}", 1e3 * t_h),
+        format!("{:.2}", 1e3 * i.bind_s),
+        format!("{:.1}", 100.0 * t_h / i.bind_s),
+        format!("{:.3}", h.median_iteration_ms),
+        format!("{:.3}", i.median_iteration_ms),
+    ]
+}
+
+/// `table1.md`: [`table1`] under its title.
+pub fn table1_document(table: &Table) -> Document {
+    let (hirm, isolines) = table1_methods();
+    let mut document = Document::default();
+    document.heading(
+        1,
+        Text::plain("Handle-set update: ")
+            .then_code(hirm)
+            .then(" against the ")
+            .then_code(isolines)
+            .then(" rebuild (Wu et al. 2015, Table 1)"),
+    );
+    document.table(table.clone());
+    document
 }
 
 /// `convergence.csv` contents: one row per iteration of every case (the scale-aware paper's Fig. 6
@@ -288,7 +327,8 @@ pub struct MeshOutput {
 }
 
 /// Write `results.csv`, `results.json`, `convergence.csv`, `handle_updates.csv`, `table1.md`,
-/// `peers.md` (`peers`: our ARAP against libigl's, [`super::peer_comparison`]; none when empty) and
+/// `peers.md` (`peers`: our ARAP against libigl's, [`super::peer_comparison::document`]; none when
+/// empty) and
 /// the result meshes `meshes/<scenario>-<method>.{glb,off}` that `meshes` asks for under `dir`.
 pub fn write_reports(
     dir: &Path,
@@ -297,7 +337,7 @@ pub fn write_reports(
     data_source: &str,
     provenance: &Provenance,
     skipped: &[SkippedInput],
-    peers: &str,
+    peers: &Document,
     meshes: &MeshOutput,
 ) -> Result<(), HarnessError> {
     let csv = render_csv(results)?;
@@ -305,9 +345,9 @@ pub fn write_reports(
     write_meshes(dir, results, scenarios, meshes)?;
     write_bytes(&dir.join("convergence.csv"), &render_convergence(results)?)?;
     write_bytes(&dir.join("handle_updates.csv"), &render_handle_updates(results)?)?;
-    write_bytes(&dir.join("table1.md"), render_table1(results).as_bytes())?;
+    table1_document(&table1(results)).write_markdown(&dir.join("table1.md"))?;
     if !peers.is_empty() {
-        write_bytes(&dir.join("peers.md"), peers.as_bytes())?;
+        peers.write_markdown(&dir.join("peers.md"))?;
     }
     write_bytes(&dir.join("results.json"), &json)?;
     write_bytes(&dir.join("results.csv"), &csv)?;

@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use crate::error::HarnessError;
 use crate::metrics::Metric;
 use crate::record::CaseResult;
+use crate::report::document::{Image, ImageGroup};
 use crate::scenario::{LoadedScenario, Role};
 
 use super::camera::{Camera, VIEW_FROM};
@@ -65,7 +66,8 @@ const FIGURES: &str = "figures";
 /// Write `figures/<scenario>-rest.png`, `figures/<scenario>-<method>.png`,
 /// `figures/<scenario>-<method>-heat.png`, `figures/<scenario>-<method>-area.png`, `figures/grid.png`,
 /// `figures/grid_heat.png`, `figures/grid_area.png` under `dir`;
-/// returns the paths written, relative to `dir` (for the HTML report).
+/// returns the images written, their paths relative to `dir`, in the page's groups (the worst-case
+/// sheets `figures/worst-<family>.png` of a dataset run too).
 ///
 /// `results` are the cases of the run (a result's `positions` are its final `#V x 3` shape on the
 /// rest connectivity of its scenario); `scenarios` give the rest meshes and the handle sets (the
@@ -79,7 +81,7 @@ pub fn write_figures(
     dir: &Path,
     results: &[CaseResult],
     scenarios: &[LoadedScenario],
-) -> Result<Vec<PathBuf>, HarnessError> {
+) -> Result<Vec<Image>, HarnessError> {
     crate::report::fonts::register_sans_serif()?;
     let columns = method_columns(results);
     let rows: Vec<Row> = scenarios
@@ -98,19 +100,51 @@ pub fn write_figures(
 
     let figures = dir.join(FIGURES);
     std::fs::create_dir_all(&figures).map_err(|error| HarnessError::Io { path: figures.clone(), error })?;
-    let mut files: Vec<(PathBuf, &RgbImage)> = Vec::new();
-    for (row, images) in rows.iter().zip(&rendered) {
+    let grids = grids(&rows, &rendered, &columns, results)
+        .map_err(|(name, e)| HarnessError::Report(format!("{}: {e}", figures.join(name).display())))?;
+    let mut files = single_renders(&rows, &rendered);
+    for (name, group, image) in &grids {
+        files.push((figure(Path::new(FIGURES).join(name), group.clone()), image));
+    }
+    write_pngs(dir, &files)?;
+    Ok(files.into_iter().map(|(image, _)| image).collect())
+}
+
+/// `path` in `group`, captioned by its stem.
+fn figure(path: PathBuf, group: ImageGroup) -> Image {
+    let caption = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    Image { group, path, caption }
+}
+
+/// Every row's rest render and each of its results' shaded, heat and area renders.
+fn single_renders<'a>(rows: &[Row], rendered: &'a [RenderedRow]) -> Vec<(Image, &'a RgbImage)> {
+    let mut files = Vec::new();
+    let mut add = |name: String, picture| {
+        files.push((figure(Path::new(FIGURES).join(name), ImageGroup::Render), picture))
+    };
+    for (row, images) in rows.iter().zip(rendered) {
         let stem = crate::stored_report::file_name(&row.scenario.spec.name);
-        files.push((Path::new(FIGURES).join(format!("{stem}-rest.png")), &images.rest));
+        add(format!("{stem}-rest.png"), &images.rest);
         for (case, cell) in row.cases.iter().zip(&images.cells) {
             if let (Some(case), Cell::Rendered { shaded, heat, area, .. }) = (case, cell) {
                 let stem = format!("{stem}-{}", crate::stored_report::file_name(&case.method));
-                files.push((Path::new(FIGURES).join(format!("{stem}.png")), shaded));
-                files.push((Path::new(FIGURES).join(format!("{stem}-heat.png")), heat));
-                files.push((Path::new(FIGURES).join(format!("{stem}-area.png")), area));
+                add(format!("{stem}.png"), shaded);
+                add(format!("{stem}-heat.png"), heat);
+                add(format!("{stem}-area.png"), area);
             }
         }
     }
+    files
+}
+
+/// The three grids (none above [`MAX_GRID_ROWS`] rows) and each family's worst-case sheet: file
+/// name, group and image; an error names the file.
+fn grids(
+    rows: &[Row],
+    rendered: &[RenderedRow],
+    columns: &[String],
+    results: &[CaseResult],
+) -> Result<Vec<(String, ImageGroup, RgbImage)>, (String, String)> {
     let grid_kinds: &[(Kind, &str)] = if rows.len() <= MAX_GRID_ROWS {
         &[(Kind::Shaded, "grid.png"), (Kind::Heat, "grid_heat.png"), (Kind::Area, "grid_area.png")]
     } else {
@@ -119,35 +153,37 @@ pub fn write_figures(
     let mut grids = grid_kinds
         .iter()
         .map(|&(kind, name)| {
-            grid_image(&rows, &rendered, &columns, kind)
-                .map(|image| (name.to_string(), image))
-                .map_err(|e| HarnessError::Report(format!("{}: {e}", figures.join(name).display())))
+            let image = grid_image(rows, rendered, columns, kind).map_err(|e| (name.to_string(), e))?;
+            Ok::<_, (String, String)>((name.to_string(), ImageGroup::Grid, image))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    for (family, (sheet_rows, sheet_rendered)) in worst_sheets(results, &rows, &rendered) {
+    for (family, (sheet_rows, sheet_rendered)) in worst_sheets(results, rows, rendered) {
         let name = format!("worst-{}.png", crate::stored_report::file_name(&family));
         let columns = ["result".to_string(), crate::record::REFERENCE_METHOD.to_string()];
         let image = grid_image(&sheet_rows, &sheet_rendered, &columns, Kind::Shaded)
-            .map_err(|e| HarnessError::Report(format!("{}: {e}", figures.join(&name).display())))?;
-        grids.push((name, image));
+            .map_err(|e| (name.clone(), e))?;
+        grids.push((name, ImageGroup::Dataset, image));
     }
-    for (name, image) in &grids {
-        files.push((Path::new(FIGURES).join(name), image));
-    }
+    Ok(grids)
+}
 
+/// Encode `files` as PNG (in parallel) and write each under `dir`, atomically.
+fn write_pngs(dir: &Path, files: &[(Image, &RgbImage)]) -> Result<(), HarnessError> {
     let encoded: Vec<Result<Vec<u8>, HarnessError>> = files
         .par_iter()
-        .map(|(path, image)| {
+        .map(|(file, image)| {
             image
                 .encode_png()
-                .map_err(|e| HarnessError::Report(format!("{}: PNG: {e}", dir.join(path).display())))
+                .map_err(|e| HarnessError::Report(format!("{}: PNG: {e}", dir.join(&file.path).display())))
         })
         .collect();
-    for ((path, _), bytes) in files.iter().zip(encoded) {
+    for ((file, _), bytes) in files.iter().zip(encoded) {
         let bytes = bytes?;
-        meshes::io::atomic_write(dir.join(path), |w| w.write_all(&bytes).map_err(meshes::MeshError::from))?;
+        meshes::io::atomic_write(dir.join(&file.path), |w| {
+            w.write_all(&bytes).map_err(meshes::MeshError::from)
+        })?;
     }
-    Ok(files.into_iter().map(|(path, _)| path).collect())
+    Ok(())
 }
 
 /// The most tests a run's grids draw: above it (a dataset run: hundreds of meshes x edits) the grids
@@ -326,6 +362,41 @@ fn render_row(row: &Row) -> RenderedRow {
     RenderedRow { rest: rest_image, cells }
 }
 
+/// Where the parts of a grid sit, in pixels.
+struct GridLayout {
+    /// Width of the row labels' column.
+    label_w: u32,
+    /// Height of a row: a cell, its caption and the gap.
+    row_h: u32,
+    width: u32,
+    height: u32,
+    /// Height of the legend above the notes.
+    legend_h: u32,
+    /// Top of the footer (legend and notes).
+    footer: i64,
+}
+
+impl GridLayout {
+    fn new(label_w: u32, columns: usize, rows: usize, kind: Kind, note_lines: usize) -> GridLayout {
+        let row_h = CELL_SIZE + CAPTION_H + ROW_GAP;
+        let width = 2 * PAD + label_w + (columns as u32 + 1) * CELL_SIZE;
+        let legend_h = LEGEND_H[(kind != Kind::Shaded) as usize];
+        let body = PAD + HEADER_H + rows.max(1) as u32 * row_h;
+        let height = body + PAD + legend_h + note_lines as u32 * NOTE_LINE_H;
+        GridLayout { label_w, row_h, width, height, legend_h, footer: body as i64 + 8 }
+    }
+
+    /// Left of column `c` (0: `rest`).
+    fn cell_x(&self, c: u32) -> i64 {
+        (PAD + self.label_w + c * CELL_SIZE) as i64
+    }
+
+    /// Top of row `r`.
+    fn cell_y(&self, r: u32) -> i64 {
+        (PAD + HEADER_H + r * self.row_h) as i64
+    }
+}
+
 /// The grid of `kind`: a header of column names, one row per scenario (label, `rest` render, one
 /// cell per column with its `E_theta / E_phi` caption), and a legend.
 fn grid_image(
@@ -334,19 +405,44 @@ fn grid_image(
     columns: &[String],
     kind: Kind,
 ) -> Result<RgbImage, String> {
-    let label_w = rows
+    let label_w = row_label_width(rows)?;
+    let notes = grid_notes(kind, 2 * PAD + label_w + (columns.len() as u32 + 1) * CELL_SIZE)?;
+    let layout = GridLayout::new(label_w, columns.len(), rows.len(), kind, notes.len());
+    let mut image = RgbImage::filled(layout.width, layout.height, [255; 3]);
+    let mut labels = column_names(&layout, columns)?;
+    image.fill_rect(PAD as i64, (PAD + HEADER_H - 4) as i64, layout.width - 2 * PAD, 1, RULE);
+    if rows.is_empty() {
+        let at = (layout.cell_x(0) as f64 + 8.0, layout.cell_y(0) as f64 + 40.0);
+        labels.push(Label::new("no results", CAPTION_PX, MUTED, at, Align::Left));
+    }
+    for (r, (row, images)) in rows.iter().zip(rendered).enumerate() {
+        draw_grid_row(&mut image, &mut labels, &layout, r as u32, row, images, kind);
+        if r + 1 < rows.len() {
+            let y = layout.cell_y(r as u32) + (CELL_SIZE + CAPTION_H + ROW_GAP / 2) as i64;
+            image.fill_rect(PAD as i64, y, layout.width - 2 * PAD, 1, RULE);
+        }
+    }
+    draw_footer(&mut image, &mut labels, &layout, kind, notes);
+    draw_labels(&mut image, &labels)?;
+    Ok(image)
+}
+
+/// The width of the row labels' column: the widest row name (or the mesh source line), at least
+/// 120 pixels, and a margin.
+fn row_label_width(rows: &[Row]) -> Result<u32, String> {
+    let widest = rows
         .iter()
         .map(|r| {
             let name = r.label.as_deref().unwrap_or(&r.scenario.spec.name);
             Label::new(name, NAME_PX, INK, (0.0, 0.0), Align::Left).width()
         })
         .chain([Label::new("procedural look-alike", DETAIL_PX, INK, (0.0, 0.0), Align::Left).width()])
-        .try_fold(120.0f64, |w, l| l.map(|l| w.max(l)))?
-        .ceil() as u32
-        + 24;
-    let row_h = CELL_SIZE + CAPTION_H + ROW_GAP;
-    let n_cols = columns.len() as u32 + 1;
-    let width = 2 * PAD + label_w + n_cols * CELL_SIZE;
+        .try_fold(120.0f64, |w, l| l.map(|l| w.max(l)))?;
+    Ok(widest.ceil() as u32 + 24)
+}
+
+/// The notes under a grid of `kind` (how it was drawn, what its captions mean), wrapped to `width`.
+fn grid_notes(kind: Kind, width: u32) -> Result<Vec<String>, String> {
     let mut notes = vec![
         format!(
             "Orthographic view from ({}, {}, {}), z up (axes turned for a scenario with another `up`); one camera per row, framing the rest shape and the \
@@ -364,138 +460,128 @@ fn grid_image(
     if kind != Kind::Shaded {
         notes.push("Rest column: fixed vertices blue, handle vertices orange.".to_string());
     }
-    let notes = notes
-        .iter()
-        .map(|n| wrap(n, DETAIL_PX, (width - 2 * PAD) as f64))
-        .collect::<Result<Vec<_>, _>>()?
-        .concat();
-    let legend_h = LEGEND_H[(kind != Kind::Shaded) as usize];
-    let footer_h = legend_h + notes.len() as u32 * NOTE_LINE_H;
-    let height = 2 * PAD + HEADER_H + rows.len().max(1) as u32 * row_h + footer_h;
-    let mut image = RgbImage::filled(width, height, [255; 3]);
-    let mut labels = Vec::new();
-    let cell_x = |c: u32| (PAD + label_w + c * CELL_SIZE) as i64;
-    let cell_y = |r: u32| (PAD + HEADER_H + r * row_h) as i64;
+    let lines =
+        notes.iter().map(|n| wrap(n, DETAIL_PX, (width - 2 * PAD) as f64)).collect::<Result<Vec<_>, _>>()?;
+    Ok(lines.concat())
+}
 
+/// The header's labels: `rest` and the column names, a long name set smaller rather than run into
+/// its neighbours.
+fn column_names(layout: &GridLayout, columns: &[String]) -> Result<Vec<Label>, String> {
+    let mut labels = Vec::new();
     for (c, name) in std::iter::once("rest").chain(columns.iter().map(String::as_str)).enumerate() {
-        let x = cell_x(c as u32) as f64 + CELL_SIZE as f64 / 2.0;
+        let x = layout.cell_x(c as u32) as f64 + CELL_SIZE as f64 / 2.0;
         let mut label = Label::new(name, NAME_PX, INK, (x, (PAD + HEADER_H - 16) as f64), Align::Center);
-        // A long method name is set smaller rather than run into its neighbours.
         let room = (CELL_SIZE - 16) as f64;
         label.size *= (room / label.width()?).min(1.0);
         labels.push(label);
     }
-    image.fill_rect(PAD as i64, (PAD + HEADER_H - 4) as i64, width - 2 * PAD, 1, RULE);
-    if rows.is_empty() {
-        labels.push(Label::new(
-            "no results",
-            CAPTION_PX,
-            MUTED,
-            (cell_x(0) as f64 + 8.0, cell_y(0) as f64 + 40.0),
-            Align::Left,
-        ));
-    }
+    Ok(labels)
+}
 
-    for (r, (row, images)) in rows.iter().zip(rendered).enumerate() {
-        let (top, mid) = (cell_y(r as u32), cell_y(r as u32) + CELL_SIZE as i64 / 2);
-        let scenario = row.scenario;
-        labels.push(Label::new(
-            row.label.as_deref().unwrap_or(&scenario.spec.name),
-            NAME_PX,
-            INK,
-            (PAD as f64, mid as f64 - 6.0),
-            Align::Left,
-        ));
-        let size = format!("{} vertices", scenario.mesh.n_vertices());
-        labels.push(Label::new(size, DETAIL_PX, MUTED, (PAD as f64, mid as f64 + 20.0), Align::Left));
-        labels.push(Label::new(
-            &scenario.mesh_source,
-            DETAIL_PX,
-            MUTED,
-            (PAD as f64, mid as f64 + 42.0),
-            Align::Left,
-        ));
-        image.paste(&images.rest, cell_x(0), top);
-        for (c, (case, cell)) in row.cases.iter().zip(&images.cells).enumerate() {
-            let (x, centre) = (cell_x(c as u32 + 1), cell_x(c as u32 + 1) as f64 + CELL_SIZE as f64 / 2.0);
-            let inset = |image: &mut RgbImage, color| {
-                image.fill_rect(x + 6, top + 6, CELL_SIZE - 12, CELL_SIZE - 12, color)
+/// Row `r`: its label (name, size, mesh source), the rest render and a cell per column.
+fn draw_grid_row(
+    image: &mut RgbImage,
+    labels: &mut Vec<Label>,
+    layout: &GridLayout,
+    r: u32,
+    row: &Row,
+    images: &RenderedRow,
+    kind: Kind,
+) {
+    let top = layout.cell_y(r);
+    let mid = (top + CELL_SIZE as i64 / 2) as f64;
+    let scenario = row.scenario;
+    let name = row.label.as_deref().unwrap_or(&scenario.spec.name);
+    labels.push(Label::new(name, NAME_PX, INK, (PAD as f64, mid - 6.0), Align::Left));
+    let size = format!("{} vertices", scenario.mesh.n_vertices());
+    labels.push(Label::new(size, DETAIL_PX, MUTED, (PAD as f64, mid + 20.0), Align::Left));
+    labels.push(Label::new(&scenario.mesh_source, DETAIL_PX, MUTED, (PAD as f64, mid + 42.0), Align::Left));
+    image.paste(&images.rest, layout.cell_x(0), top);
+    for (c, (case, cell)) in row.cases.iter().zip(&images.cells).enumerate() {
+        draw_cell(image, labels, (layout.cell_x(c as u32 + 1), top), *case, cell, kind);
+    }
+}
+
+/// The cell at `(x, top)`: `not run`, `failed`, or the result's picture of `kind` with its marks
+/// and caption.
+fn draw_cell(
+    image: &mut RgbImage,
+    labels: &mut Vec<Label>,
+    (x, top): (i64, i64),
+    case: Option<&CaseResult>,
+    cell: &Cell,
+    kind: Kind,
+) {
+    let (centre, mid) = (x as f64 + CELL_SIZE as f64 / 2.0, (top + CELL_SIZE as i64 / 2) as f64);
+    match cell {
+        Cell::NotRun => {
+            image.fill_rect(x + 6, top + 6, CELL_SIZE - 12, CELL_SIZE - 12, EMPTY_CELL);
+            labels.push(Label::new("not run", CAPTION_PX, FAINT, (centre, mid + 6.0), Align::Center));
+        }
+        Cell::Failed => {
+            image.fill_rect(x + 6, top + 6, CELL_SIZE - 12, CELL_SIZE - 12, FAILED_CELL);
+            labels.push(Label::new("failed", NAME_PX, FAILED_INK, (centre, mid + 7.0), Align::Center));
+        }
+        Cell::Rendered { shaded, heat, area, clipped } => {
+            let picture = match kind {
+                Kind::Shaded => shaded,
+                Kind::Heat => heat,
+                Kind::Area => area,
             };
-            match cell {
-                Cell::NotRun => {
-                    inset(&mut image, EMPTY_CELL);
-                    labels.push(Label::new(
-                        "not run",
-                        CAPTION_PX,
-                        FAINT,
-                        (centre, mid as f64 + 6.0),
-                        Align::Center,
-                    ));
-                }
-                Cell::Failed => {
-                    inset(&mut image, FAILED_CELL);
-                    labels.push(Label::new(
-                        "failed",
-                        NAME_PX,
-                        FAILED_INK,
-                        (centre, mid as f64 + 7.0),
-                        Align::Center,
-                    ));
-                }
-                Cell::Rendered { shaded, heat, area, clipped } => {
-                    let picture = match kind {
-                        Kind::Shaded => shaded,
-                        Kind::Heat => heat,
-                        Kind::Area => area,
-                    };
-                    image.paste(picture, x, top);
-                    let mut marks = Vec::new();
-                    if *clipped {
-                        marks.push(("clipped: leaves the frame", FAILED_INK));
-                    }
-                    if case.is_some_and(|c| c.status.is_unfinished()) {
-                        marks.push(("unfinished: stopped at its cap", UNFINISHED_INK));
-                    }
-                    if case.is_some_and(|c| c.status.shape_reasons().next().is_some()) {
-                        marks.push(("suspect", SUSPECT_INK));
-                    }
-                    if let Some((_, color)) = marks.first() {
-                        image.outline_rect(x + 2, top + 2, CELL_SIZE - 4, CELL_SIZE - 4, 3, *color);
-                    }
-                    for (i, (text, color)) in marks.iter().enumerate() {
-                        let at = (centre, (top + 28 + 24 * i as i64) as f64);
-                        labels.push(Label::new(*text, DETAIL_PX, *color, at, Align::Center));
-                    }
-                    if let Some(case) = case {
-                        let caption = (centre, (top + CELL_SIZE as i64 + 27) as f64);
-                        labels.push(match kind {
-                            Kind::Area => area_caption(case.metric(Metric::EArea), caption),
-                            _ => {
-                                error_caption(case.metric(Metric::ETheta), case.metric(Metric::EPhi), caption)
-                            }
-                        });
-                    }
-                }
+            image.paste(picture, x, top);
+            let marks = cell_marks(case, *clipped);
+            if let Some((_, color)) = marks.first() {
+                image.outline_rect(x + 2, top + 2, CELL_SIZE - 4, CELL_SIZE - 4, 3, *color);
+            }
+            for (i, (text, color)) in marks.iter().enumerate() {
+                let at = (centre, (top + 28 + 24 * i as i64) as f64);
+                labels.push(Label::new(*text, DETAIL_PX, *color, at, Align::Center));
+            }
+            if let Some(case) = case {
+                let at = (centre, (top + CELL_SIZE as i64 + 27) as f64);
+                labels.push(match kind {
+                    Kind::Area => area_caption(case.metric(Metric::EArea), at),
+                    _ => error_caption(case.metric(Metric::ETheta), case.metric(Metric::EPhi), at),
+                });
             }
         }
-        if r + 1 < rows.len() {
-            let y = top + (CELL_SIZE + CAPTION_H + ROW_GAP / 2) as i64;
-            image.fill_rect(PAD as i64, y, width - 2 * PAD, 1, RULE);
-        }
     }
+}
 
-    let footer = (PAD + HEADER_H + rows.len().max(1) as u32 * row_h) as i64 + 8;
+/// The marks on a rendered cell, the first one's colour outlining it: clipped, unfinished, suspect.
+fn cell_marks(case: Option<&CaseResult>, clipped: bool) -> Vec<(&'static str, [u8; 3])> {
+    let mut marks = Vec::new();
+    if clipped {
+        marks.push(("clipped: leaves the frame", FAILED_INK));
+    }
+    if case.is_some_and(|c| c.status.is_unfinished()) {
+        marks.push(("unfinished: stopped at its cap", UNFINISHED_INK));
+    }
+    if case.is_some_and(|c| c.status.shape_reasons().next().is_some()) {
+        marks.push(("suspect", SUSPECT_INK));
+    }
+    marks
+}
+
+/// The legend of `kind` and the notes under the rows.
+fn draw_footer(
+    image: &mut RgbImage,
+    labels: &mut Vec<Label>,
+    layout: &GridLayout,
+    kind: Kind,
+    notes: Vec<String>,
+) {
+    let footer = layout.footer;
     match kind {
-        Kind::Shaded => role_legend(&mut image, &mut labels, PAD as i64, footer),
-        Kind::Heat => heat_legend(&mut image, &mut labels, PAD as i64, footer),
-        Kind::Area => area_legend(&mut image, &mut labels, PAD as i64, footer),
+        Kind::Shaded => role_legend(image, labels, PAD as i64, footer),
+        Kind::Heat => heat_legend(image, labels, PAD as i64, footer),
+        Kind::Area => area_legend(image, labels, PAD as i64, footer),
     }
     for (i, line) in notes.into_iter().enumerate() {
-        let y = footer + (legend_h + (i as u32 + 1) * NOTE_LINE_H) as i64 - 8;
+        let y = footer + (layout.legend_h + (i as u32 + 1) * NOTE_LINE_H) as i64 - 8;
         labels.push(Label::new(line, DETAIL_PX, MUTED, (PAD as f64, y as f64), Align::Left));
     }
-    draw_labels(&mut image, &labels)?;
-    Ok(image)
 }
 
 /// "E_θ x.xx° / E_φ y.yy°" centred at `(x, baseline)`.
@@ -672,6 +758,22 @@ mod tests {
         (results, scenarios)
     }
 
+    /// The paths of `images`, and that each is in the group its name says.
+    fn paths(images: Vec<Image>) -> Vec<PathBuf> {
+        for i in &images {
+            let name = i.path.file_name().unwrap().to_string_lossy();
+            let group = if name.starts_with("grid") {
+                ImageGroup::Grid
+            } else if name.starts_with("worst-") {
+                ImageGroup::Dataset
+            } else {
+                ImageGroup::Render
+            };
+            assert_eq!(i.group, group, "{name}");
+        }
+        images.into_iter().map(|i| i.path).collect()
+    }
+
     fn decode(path: &Path) -> image::RgbImage {
         image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgb8()
     }
@@ -680,7 +782,7 @@ mod tests {
     fn write_figures_writes_every_expected_file_deterministically() {
         let (results, scenarios) = inputs();
         let dirs = [tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap()];
-        let written = write_figures(dirs[0].path(), &results, &scenarios).unwrap();
+        let written = paths(write_figures(dirs[0].path(), &results, &scenarios).unwrap());
         let expected = [
             "tiny-rest.png",
             "tiny-laplacian.png",
@@ -719,7 +821,7 @@ mod tests {
         assert_eq!(heat.width(), grid.width());
         assert!(heat.height() > grid.height(), "the colour bar takes more room than the swatches");
 
-        assert_eq!(write_figures(dirs[1].path(), &results, &scenarios).unwrap(), written);
+        assert_eq!(paths(write_figures(dirs[1].path(), &results, &scenarios).unwrap()), written);
         for path in &written {
             let bytes = |d: &tempfile::TempDir| std::fs::read(d.path().join(path)).unwrap();
             assert!(bytes(&dirs[0]) == bytes(&dirs[1]), "{} differs between runs", path.display());
@@ -762,7 +864,7 @@ mod tests {
     #[test]
     fn no_results_still_give_every_grid() {
         let dir = tempfile::tempdir().unwrap();
-        let written = write_figures(dir.path(), &[], &[scenario("unused")]).unwrap();
+        let written = paths(write_figures(dir.path(), &[], &[scenario("unused")]).unwrap());
         assert_eq!(
             written,
             [
@@ -786,7 +888,7 @@ mod tests {
         with_runaway.push(case("tiny", "hirm", "suspect: leaves its frame", Some(far)));
         let dirs = [tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap()];
         write_figures(dirs[0].path(), &results, &scenarios).unwrap();
-        let written = write_figures(dirs[1].path(), &with_runaway, &scenarios).unwrap();
+        let written = paths(write_figures(dirs[1].path(), &with_runaway, &scenarios).unwrap());
         for name in ["tiny-rest.png", "tiny-laplacian.png", "tiny-laplacian-heat.png"] {
             let bytes = |d: &tempfile::TempDir| std::fs::read(d.path().join("figures").join(name)).unwrap();
             assert!(
