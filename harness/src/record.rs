@@ -42,13 +42,14 @@ impl CaseKey {
 /// A run's results with an index by [`CaseKey`]: the one way a report finds another case of the
 /// same scenario (the reference's, a peer's).
 pub struct CaseIndex<'a> {
-    results: &'a [CaseResult],
+    results: Vec<&'a CaseResult>,
     by_key: std::collections::HashMap<CaseKey, usize>,
 }
 
 impl<'a> CaseIndex<'a> {
     /// The index of `results` (a key seen twice keeps its first case).
-    pub fn new(results: &'a [CaseResult]) -> Self {
+    pub fn new(results: impl IntoIterator<Item = &'a CaseResult>) -> Self {
+        let results: Vec<&CaseResult> = results.into_iter().collect();
         let mut by_key = std::collections::HashMap::with_capacity(results.len());
         for (i, r) in results.iter().enumerate() {
             by_key.entry(r.key()).or_insert(i);
@@ -58,7 +59,7 @@ impl<'a> CaseIndex<'a> {
 
     /// The case `key`, if the run has it.
     pub fn get(&self, key: &CaseKey) -> Option<&'a CaseResult> {
-        self.by_key.get(key).map(|&i| &self.results[i])
+        self.by_key.get(key).map(|&i| self.results[i])
     }
 
     /// The case of `method` on `case`'s scenario.
@@ -72,11 +73,11 @@ impl<'a> CaseIndex<'a> {
     }
 
     /// The cases of scenario `scenario`, in run order.
-    pub fn of_scenario<'s>(&self, scenario: &'s str) -> impl Iterator<Item = &'a CaseResult> + 's
+    pub fn of_scenario<'s>(&'s self, scenario: &'s str) -> impl Iterator<Item = &'a CaseResult> + 's
     where
         'a: 's,
     {
-        self.results.iter().filter(move |r| r.scenario == scenario)
+        self.results.iter().copied().filter(move |r| r.scenario == scenario)
     }
 }
 

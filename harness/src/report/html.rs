@@ -488,13 +488,12 @@ pub const LOWER_ENERGY_MARGIN: f64 = 1e-6;
 pub fn below_the_reference_cases(results: &[CaseResult]) -> Vec<(&CaseResult, f64, f64)> {
     use crate::metrics::Metric;
     let mut below = Vec::new();
+    let index = crate::record::CaseIndex::new(results);
     for r in results {
         if r.method == crate::record::REFERENCE_METHOD {
             continue;
         }
-        let reference = results.iter().find(|q| {
-            q.method == crate::record::REFERENCE_METHOD && q.scenario == r.scenario && q.member == r.member
-        });
+        let reference = index.reference_of(r);
         let (Some(mine), Some(theirs)) =
             (r.quality.get(Metric::ArapEnergy), reference.and_then(|q| q.quality.get(Metric::ArapEnergy)))
         else {

@@ -7,7 +7,7 @@
 
 use super::document::{Column, Document, Table, Text};
 use crate::record::CaseResult;
-use crate::record::{LIKE_FOR_LIKE_REFERENCE, PEER_OF_REFERENCE, REFERENCE_METHOD};
+use crate::record::{CaseIndex, CaseKey, LIKE_FOR_LIKE_REFERENCE, PEER_OF_REFERENCE, REFERENCE_METHOD};
 use crate::scenario::LoadedScenario;
 
 /// One of our ARAP rows set against libigl's on one test.
@@ -57,10 +57,10 @@ fn rms_distance(a: &[[f64; 3]], b: &[[f64; 3]], diagonal: f64) -> f64 {
 
 /// Every scenario of `scenarios` where `arap` and `libigl_arap` both have a result, in order.
 pub fn arap_against_libigl(results: &[CaseResult], scenarios: &[LoadedScenario]) -> Vec<ArapAgainstLibigl> {
+    let index = CaseIndex::new(results);
     let find = |scenario: &str, method: &str| {
-        results
-            .iter()
-            .find(|r| r.scenario == scenario && r.method == method && !r.status.is_failed())
+        (index.get(&CaseKey::new(scenario, method)))
+            .filter(|r| !r.status.is_failed())
             .and_then(|r| Some((r, r.positions.as_deref()?)))
     };
     scenarios

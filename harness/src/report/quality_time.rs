@@ -17,15 +17,13 @@ pub const MIN_SWEEP_POINTS: usize = 3;
 /// order.
 pub fn swept_scenarios(results: &[CaseResult]) -> Vec<&str> {
     let mut out: Vec<&str> = Vec::new();
+    let index = crate::record::CaseIndex::new(results);
     for r in results.iter().filter(|r| !r.sweeps.is_empty()) {
         if out.contains(&r.scenario.as_str()) {
             continue;
         }
         let swept = r.sweeps.iter().any(|p| {
-            results
-                .iter()
-                .filter(|c| c.scenario == r.scenario && c.sweeps.iter().any(|q| q.sweep == p.sweep))
-                .count()
+            (index.of_scenario(&r.scenario)).filter(|c| c.sweeps.iter().any(|q| q.sweep == p.sweep)).count()
                 >= MIN_SWEEP_POINTS
         });
         if swept {

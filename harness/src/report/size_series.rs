@@ -80,10 +80,11 @@ fn cases_table(cases: &[&CaseResult], methods: &[&str], scenarios: &[LoadedScena
         right("peak memory"),
         left("status"),
     ]);
+    let index = crate::record::CaseIndex::new(cases.iter().copied());
     for m in methods {
         for (vertices, scenario) in &sizes {
             let head = [m.to_string(), scenario.to_string(), vertices.to_string()];
-            if let Some(c) = cases.iter().find(|c| c.method == *m && c.scenario == *scenario) {
+            if let Some(c) = index.get(&crate::record::CaseKey::new(scenario, m)) {
                 let measured = [
                     seconds(c.precompute_s),
                     seconds(c.bind_s),

@@ -205,9 +205,9 @@ pub fn table1(results: &[CaseResult]) -> Table {
          (harmonic fields, isolines, reduced system). P = t_h / rebuild. t_i: median iteration."
     ));
     let side = |r: &CaseResult| methods::registry::table1_side(&r.method);
+    let index = crate::record::CaseIndex::new(results);
     for hirm in results.iter().filter(|r| side(r) == Some(Table1Side::HandleIndependent)) {
-        let Some(isolines) =
-            results.iter().find(|r| side(r) == Some(Table1Side::Rebuilt) && r.scenario == hirm.scenario)
+        let Some(isolines) = index.of_scenario(&hirm.scenario).find(|r| side(r) == Some(Table1Side::Rebuilt))
         else {
             continue;
         };

@@ -84,6 +84,7 @@ pub fn write_figures(
 ) -> Result<Vec<Image>, HarnessError> {
     crate::report::fonts::register_sans_serif()?;
     let columns = method_columns(results);
+    let index = crate::record::CaseIndex::new(results);
     let rows: Vec<Row> = scenarios
         .iter()
         .filter(|s| results.iter().any(|r| r.scenario == s.spec.name))
@@ -92,7 +93,7 @@ pub fn write_figures(
             label: None,
             cases: columns
                 .iter()
-                .map(|m| results.iter().find(|r| r.scenario == scenario.spec.name && &r.method == m))
+                .map(|m| index.get(&crate::record::CaseKey::new(&scenario.spec.name, m)))
                 .collect(),
         })
         .collect();
