@@ -3,6 +3,7 @@
 
 pub mod arap;
 pub mod error;
+#[cfg(feature = "external")]
 pub mod external;
 pub mod handles;
 pub mod hirm;
