@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use crate::config::{ConfiguredMethod, Origin};
 use crate::metrics::{
-    angle_errors, asked_scale, asked_turn, largest_displacement, Bends, Evaluation, Quality, RestGeometry,
+    angle_errors, asked_scale, asked_turn, evaluate_on, largest_displacement, Bends, RestGeometry,
 };
 use crate::record::{
     records_quality, CaseResult, IterationRecord, ReusedSolveRecord, Spread, StepRecord, TimingSpread,
@@ -273,14 +273,14 @@ pub fn run_case(
             Reference::Of { positions, finished } => (Some(positions), finished),
             Reference::Missing => (None, false),
         };
-        result.quality = Quality::evaluate(&Evaluation::new(
+        result.quality = evaluate_on(
             rest,
             &scenario.mesh,
             &scenario.topology,
             &positions,
             (&step.handles, &targets),
             reference,
-        ));
+        );
         result.largest_move_over_diag =
             largest_displacement(scenario.mesh.positions(), &positions) / rest.diagonal;
         result.largest_handle_move_over_diag = largest_handle_move / rest.diagonal;
