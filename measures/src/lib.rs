@@ -19,7 +19,7 @@
 //! - [`statistics`]: RMS and percentiles;
 //! - [`verdict`], [`status`], [`step_trend`]: the rules that make a case `suspect`, the status they
 //!   give, and why an iteration did not finish;
-//! - [`error`]: [`MeasuresError`].
+//! - [`error`]: what can go wrong ([`MeasuresError`]).
 //!
 //! Decision (issue 61): the print format of a measure ([`Format`], a column of [`METRICS`]) stays
 //! here although it is presentation: it is one field of the table row that defines a measure, so a

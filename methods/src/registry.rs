@@ -15,6 +15,9 @@ use crate::spectral_mhb::SpectralMhb;
 // another, as `scale_aware_ora` names the `scale_aware` it reuses, without importing this table).
 pub use crate::keys::method_name::*;
 
+/// What builds a method: from its parameter table and the memo of solves it may share.
+pub type Constructor = fn(&toml::Table, &SolveMemo) -> Result<Box<dyn DeformationMethod>, MethodError>;
+
 /// One registered method.
 pub struct MethodEntry {
     /// Name used in configs, on the command line and in reports.
@@ -24,7 +27,7 @@ pub struct MethodEntry {
     /// Build the method from its parameter table (missing keys take the paper's defaults), with the
     /// memo of solves it shares with the other instances given the same one (only `scale_aware*`
     /// use it; [`crate::scale_aware::solve_memo`]).
-    pub create: fn(&toml::Table, &SolveMemo) -> Result<Box<dyn DeformationMethod>, MethodError>,
+    pub create: Constructor,
     /// Whether `solve` iterates (takes `max_iterations` and `tolerance`); `false` for a direct solve.
     pub iterative: bool,
     /// Its cost, seconds per 1000 vertices per edit step: what the harness balances a cluster's
