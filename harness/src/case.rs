@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use crate::config::{ConfiguredMethod, Origin};
 use crate::metrics::{
-    angle_errors, asked_scale, asked_turn, largest_displacement, Bends, Evaluation, Quality, RestGeometry,
+    angle_errors, asked_scale, asked_turn, evaluate_on, largest_displacement, Bends, Quality, RestGeometry,
 };
 use crate::record::{
     records_quality, CaseResult, IterationRecord, MeasurementTime, ReusedSolveRecord, Spread, StepRecord,
@@ -244,14 +244,14 @@ fn judge(
         Reference::Of { positions, finished } => (Some(positions), finished),
         Reference::Missing => (None, false),
     };
-    let quality = Quality::evaluate(&Evaluation::new(
+    let quality = evaluate_on(
         rest,
         &scenario.mesh,
         &scenario.topology,
         positions,
         (handles, &last.targets),
         reference,
-    ));
+    );
     let rest_positions = scenario.mesh.positions();
     let largest_handle_move = (drive.steps.iter().zip(&scenario.steps))
         .flat_map(|(driven, step)| step.handles.constrained().zip(driven.targets.positions()))

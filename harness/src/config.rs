@@ -89,6 +89,12 @@ impl std::fmt::Debug for Implementation {
     }
 }
 
+/// The memo of solves every built-in method instance of the process shares
+/// ([`methods::scale_aware::solve_memo`]): the `scale_aware_ora` case of a scenario edit step takes
+/// the identical solve of its `scale_aware` case instead of computing it again.
+static SHARED_SOLVES: std::sync::LazyLock<methods::scale_aware::SolveMemo> =
+    std::sync::LazyLock::new(Default::default);
+
 /// One method of a run.
 #[derive(Clone, Debug)]
 pub struct ConfiguredMethod {
@@ -127,7 +133,7 @@ impl ConfiguredMethod {
             });
         }
         match &self.implementation {
-            Implementation::BuiltIn(entry) => (entry.create)(&self.params),
+            Implementation::BuiltIn(entry) => (entry.create)(&self.params, &SHARED_SOLVES),
             Implementation::External(e) => Ok(Box::new(ExternalMethod::start(ExternalSpec {
                 name: self.name.clone(),
                 program: e.program.clone(),

@@ -25,6 +25,20 @@ pub enum HarnessError {
     Memory(#[from] Box<crate::memory::MemoryRefusal>),
 }
 
+impl From<measures::MeasuresError> for HarnessError {
+    /// A rules file's error as the harness's own kind of it, with the same message.
+    fn from(error: measures::MeasuresError) -> Self {
+        use measures::MeasuresError as E;
+        match error {
+            E::Read { path, error } => HarnessError::Io { path, error },
+            E::Rules { path, message } => HarnessError::Config { path, message },
+            E::Mesh(e) => HarnessError::Mesh(e),
+            E::Handles(e) => HarnessError::Method(e),
+            E::Size(message) => HarnessError::Report(message),
+        }
+    }
+}
+
 /// ` (did you mean `x`?)` when one of `known` is a likely misspelling of `name` (the nearest by
 /// Damerau–Levenshtein distance, ignoring case, at most a third of the name's length away and at
 /// least 2; else one that `name` begins), or nothing.

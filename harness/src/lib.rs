@@ -16,7 +16,8 @@
 //! stored_report, regression, pareto   records on disk (results.json), the gate, the fronts
 //! record, provenance             the run's record: what each case measured; where and how it ran
 //! config, scenario, shard, sweep, metrics, verdict, step_trend   what a run is made of, measures,
-//!                                verdict rules, why an iteration did not finish
+//!                                verdict rules, why an iteration did not finish (the last three
+//!                                re-exports of the `measures` crate)
 //! paths, error, threads, variables, memory, staged_dir   the workspace, errors, threads, ${VAR},
 //!                                RSS, a directory replaced whole
 //! ```

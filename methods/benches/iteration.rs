@@ -69,7 +69,7 @@ fn per_iteration(c: &mut Criterion) {
                 // libigl's arap_solve (scripts/bench-vs-libigl) starts from the current shape.
                 params.insert("start".into(), "current".into());
             }
-            let mut method = (entry.create)(&params).expect("method");
+            let mut method = (entry.create)(&params, &Default::default()).expect("method");
             method.precompute(&mesh).expect("precompute");
             method.bind_handles(&handles).expect("bind");
             group.bench_function(BenchmarkId::new(entry.name, &label), |b| {

@@ -4,6 +4,7 @@
 pub mod arap;
 pub mod drive;
 pub mod error;
+#[cfg(feature = "external")]
 pub mod external;
 pub mod handles;
 pub mod hirm;

@@ -8,12 +8,15 @@ use crate::hirm::Hirm;
 use crate::isolines::Isolines;
 use crate::laplacian::LaplacianEditing;
 use crate::method::DeformationMethod;
-use crate::scale_aware::ScaleAware;
+use crate::scale_aware::{ScaleAware, SolveMemo};
 use crate::spectral_mhb::SpectralMhb;
 
 // The registered method names live in `crate::keys::method_name` (a method module may name
 // another, as `scale_aware_ora` names the `scale_aware` it reuses, without importing this table).
 pub use crate::keys::method_name::*;
+
+/// What builds a method: from its parameter table and the memo of solves it may share.
+pub type Constructor = fn(&toml::Table, &SolveMemo) -> Result<Box<dyn DeformationMethod>, MethodError>;
 
 /// One registered method.
 pub struct MethodEntry {
@@ -21,8 +24,10 @@ pub struct MethodEntry {
     pub name: &'static str,
     /// One line: what it is and where it comes from.
     pub summary: &'static str,
-    /// Build the method from its parameter table (missing keys take the paper's defaults).
-    pub create: fn(&toml::Table) -> Result<Box<dyn DeformationMethod>, MethodError>,
+    /// Build the method from its parameter table (missing keys take the paper's defaults), with the
+    /// memo of solves it shares with the other instances given the same one (only `scale_aware*`
+    /// use it; [`crate::scale_aware::solve_memo`]).
+    pub create: Constructor,
     /// Whether `solve` iterates (takes `max_iterations` and `tolerance`); `false` for a direct solve.
     pub iterative: bool,
     /// Its cost, seconds per 1000 vertices per edit step: what the harness balances a cluster's
@@ -57,7 +62,7 @@ pub const METHODS: &[MethodEntry] = &[
     MethodEntry {
         name: LAPLACIAN,
         summary: "unreduced iterative Laplacian editing (Au et al. 2007 sec. 3, eq 1-3), the reference the reduced models approximate",
-        create: |p| Ok(Box::new(LaplacianEditing::new(parse(LAPLACIAN, p)?)?)),
+        create: |p, _| Ok(Box::new(LaplacianEditing::new(parse(LAPLACIAN, p)?)?)),
         iterative: true,
         seconds_per_kilovertex: 0.10,
         bytes_per_vertex: 7_600, // 15.1 GiB at 2.1M
@@ -66,7 +71,7 @@ pub const METHODS: &[MethodEntry] = &[
     MethodEntry {
         name: ARAP,
         summary: "As-Rigid-As-Possible surface modeling (Sorkine & Alexa 2007), cotangent weights (intrinsic Delaunay by default), hard constraints",
-        create: |p| Ok(Box::new(Arap::new(parse(ARAP, p)?)?)),
+        create: |p, _| Ok(Box::new(Arap::new(parse(ARAP, p)?)?)),
         iterative: true,
         seconds_per_kilovertex: 0.25,
         bytes_per_vertex: 3_200, // 6.33 GiB at 2.1M
@@ -75,7 +80,7 @@ pub const METHODS: &[MethodEntry] = &[
     MethodEntry {
         name: HIRM,
         summary: "handle-independent reduced model for incremental editing: isolines of Laplacian eigenvectors, background precompute (Wu, Au, Tai & Lu 2015)",
-        create: |p| Ok(Box::new(Hirm::new(parse(HIRM, p)?)?)),
+        create: |p, _| Ok(Box::new(Hirm::new(parse(HIRM, p)?)?)),
         iterative: true,
         seconds_per_kilovertex: 0.043,
         bytes_per_vertex: 3_300, // 6.58 GiB at 2.1M
@@ -84,7 +89,7 @@ pub const METHODS: &[MethodEntry] = &[
     MethodEntry {
         name: SPECTRAL_MHB,
         summary: "spectral mesh deformation in manifold harmonics bases with deformation transfer of details (Rong, Cao & Guo 2008)",
-        create: |p| Ok(Box::new(SpectralMhb::new(parse(SPECTRAL_MHB, p)?)?)),
+        create: |p, _| Ok(Box::new(SpectralMhb::new(parse(SPECTRAL_MHB, p)?)?)),
         iterative: false,
         seconds_per_kilovertex: 0.039,
         bytes_per_vertex: 3_100, // 3.04 GB at 1M (14.4 GiB at 2.1M before 793b558)
@@ -93,7 +98,7 @@ pub const METHODS: &[MethodEntry] = &[
     MethodEntry {
         name: SCALE_AWARE,
         summary: "scale-aware shape manipulation: triangle and edge angles, normals on the Gauss map, then G(Theta, N) V = 0 (Liu, Wang, Liu & Liu 2014)",
-        create: |p| Ok(Box::new(ScaleAware::new(SCALE_AWARE, parse(SCALE_AWARE, p)?)?)),
+        create: |p, memo| Ok(Box::new(ScaleAware::sharing(SCALE_AWARE, parse(SCALE_AWARE, p)?, memo.clone())?)),
         iterative: true,
         seconds_per_kilovertex: 0.48,
         bytes_per_vertex: 11_100, // 1.38 GiB at 134K
@@ -102,7 +107,7 @@ pub const METHODS: &[MethodEntry] = &[
     MethodEntry {
         name: SCALE_AWARE_ORA,
         summary: "`scale_aware` followed by the optimal rigidity approximation: triangles rescaled to their rest areas and stitched (section 5.3)",
-        create: |p| Ok(Box::new(ScaleAware::new(SCALE_AWARE_ORA, parse(SCALE_AWARE_ORA, p)?)?)),
+        create: |p, memo| Ok(Box::new(ScaleAware::sharing(SCALE_AWARE_ORA, parse(SCALE_AWARE_ORA, p)?, memo.clone())?)),
         iterative: true,
         seconds_per_kilovertex: 0.44,
         bytes_per_vertex: 11_100, // scale_aware's
@@ -111,7 +116,7 @@ pub const METHODS: &[MethodEntry] = &[
     MethodEntry {
         name: ISOLINES,
         summary: "handle-aware isolines reduced model (Au, Fu, Tai & Cohen-Or 2007), n_iso = 20, isoline-interpolated Laplacian coordinates (Table 1 t_2)",
-        create: |p| Ok(Box::new(Isolines::new(ISOLINES, parse(ISOLINES, p)?)?)),
+        create: |p, _| Ok(Box::new(Isolines::new(ISOLINES, parse(ISOLINES, p)?)?)),
         iterative: true,
         seconds_per_kilovertex: 0.0042,
         bytes_per_vertex: 2_000, // 3.85 GiB at 2.1M
@@ -120,7 +125,7 @@ pub const METHODS: &[MethodEntry] = &[
     MethodEntry {
         name: ISOLINES_T1,
         summary: "`isolines` with vertex interpolation only: Laplacian coordinates on the whole mesh per iteration (Au et al. 2007 eq 6, Table 1 t_1)",
-        create: |p| Ok(Box::new(Isolines::new(ISOLINES_T1, parse(ISOLINES_T1, p)?)?)),
+        create: |p, _| Ok(Box::new(Isolines::new(ISOLINES_T1, parse(ISOLINES_T1, p)?)?)),
         iterative: true,
         seconds_per_kilovertex: 0.0081,
         bytes_per_vertex: 2_000, // isolines'; not measured at 2.1M
@@ -151,9 +156,20 @@ pub fn find(name: &str) -> Result<&'static MethodEntry, MethodError> {
         .ok_or_else(|| MethodError::UnknownMethod { name: name.to_string(), known: method_names() })
 }
 
-/// Build method `name` with `params` (a TOML table of its parameters; unknown keys are errors).
+/// Build method `name` with `params` (a TOML table of its parameters; unknown keys are errors),
+/// sharing solves with no other instance.
 pub fn create(name: &str, params: &toml::Table) -> Result<Box<dyn DeformationMethod>, MethodError> {
-    (find(name)?.create)(params)
+    create_sharing(name, params, &SolveMemo::default())
+}
+
+/// [`create`], the instance sharing `memo` with the others made with it: `scale_aware_ora` then
+/// takes an identical solve of `scale_aware` instead of computing it again.
+pub fn create_sharing(
+    name: &str,
+    params: &toml::Table,
+    memo: &SolveMemo,
+) -> Result<Box<dyn DeformationMethod>, MethodError> {
+    (find(name)?.create)(params, memo)
 }
 
 fn parse<P: DeserializeOwned>(method: &'static str, table: &toml::Table) -> Result<P, MethodError> {

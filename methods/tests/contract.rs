@@ -94,7 +94,7 @@ fn configured(name: &str) -> toml::Table {
 /// `entry` built from its configured parameters. They are used as they are, `max_iterations`
 /// included: on the fixture every method's whole contract takes a few seconds.
 fn create(entry: &MethodEntry) -> Result<Box<dyn DeformationMethod>, MethodError> {
-    (entry.create)(&configured(entry.name))
+    (entry.create)(&configured(entry.name), &Default::default())
 }
 
 /// `entry`, precomputed on the bar, bound to `handles` and solved towards `targets`.

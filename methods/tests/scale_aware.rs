@@ -10,7 +10,7 @@ use meshes::vector::{norm, sub};
 use meshes::{Topology, TriMesh, VertexStatus};
 use methods::scale_aware::{
     rescaled_triangles, AndersonAcceleration, LaterStart, NormalPyramids, ScaleAware, ScaleAwareEquations,
-    ScaleAwareParams, ScaleInvariantMeasures,
+    ScaleAwareParams, ScaleInvariantMeasures, SolveMemo,
 };
 use methods::{DeformationMethod, HandleRegion, HandleSet, HandleTargets, MethodError, NoObserver};
 
@@ -205,19 +205,21 @@ impl methods::IterationObserver for Reports {
 
 #[test]
 fn ora_takes_an_identical_scale_aware_solve_and_gives_the_same_result() {
-    // A mesh of its own (no other test solves it), so the first ORA solve finds nothing to take.
     let (mesh, handles) = cylinder_of(640);
     let bent: Vec<[f64; 3]> =
         mesh.positions().iter().map(|p| [p[0] + 0.2 * p[2] * p[2], p[1], p[2]]).collect();
     let targets = targets_from(&handles, &bent);
-    let run = |params: ScaleAwareParams, name: &'static str| {
-        let mut m = ScaleAware::new(name, params).unwrap();
+    // The instances of this test share one memo; an instance with a memo of its own takes nothing.
+    let shared = SolveMemo::default();
+    let run_with = |params: ScaleAwareParams, name: &'static str, memo: &SolveMemo| {
+        let mut m = ScaleAware::sharing(name, params, memo.clone()).unwrap();
         m.precompute(&mesh).unwrap();
         m.bind_handles(&handles).unwrap();
         let mut reports = Reports(Vec::new());
         let summary = m.solve(&targets, &mut reports).unwrap();
         (m, summary, reports.0)
     };
+    let run = |params: ScaleAwareParams, name: &'static str| run_with(params, name, &shared);
     // A second edit step from the (stitched) result: no solve of it is stored, so it is computed.
     let second_step = |m: &mut ScaleAware| {
         let further =
@@ -246,6 +248,8 @@ fn ora_takes_an_identical_scale_aware_solve_and_gives_the_same_result() {
     assert!(taken_reports[1].1.is_some(), "the iterates asked for are replayed");
     assert!(max_distance(&plain.positions(), &taken.positions()) > 0.0, "the stitching moved the result");
     assert_eq!(second_step(&mut taken), second_step(&mut computed), "nor that of the next edit step");
+    let (alone, _, _) = run_with(ora.clone(), "scale_aware_ora", &SolveMemo::default());
+    assert_eq!(alone.reused_solve(), None, "a memo of its own holds no other instance's solve");
 
     // Another constraint weight: a solve of other inputs is not taken.
     let (other, _, _) = run(ScaleAwareParams { constraint_weight: 50.0, ..ora }, "scale_aware_ora");

@@ -50,14 +50,14 @@
 //!   solve ends at can depend on the path: on the survey cylinder depth 10, or step-two solves
 //!   lagged by one correction, end 1.2-1.4e-3 (RMS over the diagonal) from depth 5's fixed point,
 //!   with E_phi within 0.01 deg; hence depth 5 and the corrected lagged step.
-//! - `scale_aware_ora` runs Algorithm 1 exactly as `scale_aware` does, so where `scale_aware` has
-//!   just solved the same inputs in this process (the same rest mesh, parameters, handles, targets
-//!   and start shape: a case of each on one scenario edit step), it takes that result
-//!   ([`solve_memo`]) and only stitches; [`DeformationMethod::reused_solve`] reports the
-//!   seconds of the solve it took, which the harness adds to its solve time. The iterations of the
-//!   taken solve are reported again, with the iterates its observer asked for (the harness's angle
-//!   errors of the trace), so that traces and counts are those of the computation. An observer
-//!   that stops such a replay gets the taken solve's final shape.
+//! - `scale_aware_ora` runs Algorithm 1 exactly as `scale_aware` does, so where a `scale_aware`
+//!   instance sharing its [`SolveMemo`] has just solved the same inputs (the same rest mesh,
+//!   parameters, handles, targets and start shape: a case of each on one scenario edit step), it
+//!   takes that result ([`solve_memo`]) and only stitches; [`DeformationMethod::reused_solve`]
+//!   reports the seconds of the solve it took, which the harness adds to its solve time. The
+//!   iterations of the taken solve are reported again, with the iterates its observer asked for
+//!   (the harness's angle errors of the trace), so that traces and counts are those of the
+//!   computation. An observer that stops such a replay gets the taken solve's final shape.
 //! - Step one's inner loop rarely meets `normal_tolerance` within `normal_sweeps`: the smooth
 //!   rotation of the Gauss map that carries the bend is its slowest mode, and the outer iteration
 //!   depends on it not converging (fully converged, step one would rotate the rest normals
@@ -85,6 +85,7 @@ pub use gauss_map::{NormalPyramids, NormalUpdate, SpokeWeights};
 pub use optimal_rigidity::{rescaled_triangles, Stitching};
 pub use scale_aware_equations::ScaleAwareEquations;
 pub use scale_invariant_measures::ScaleInvariantMeasures;
+pub use solve_memo::SolveMemo;
 pub use vertex_recovery::{RecoveryTimings, VertexRecovery};
 
 use crate::error::MethodError;
@@ -254,14 +255,28 @@ pub struct ScaleAware {
     timings: SolveTimings,
     /// The solve the last `solve` took from `scale_aware` instead of computing it.
     reused: Option<ReusedSolve>,
+    /// Where `scale_aware` keeps its solves and `scale_aware_ora` looks for them: this instance's
+    /// own, or one it shares with others ([`ScaleAware::sharing`]).
+    memo: SolveMemo,
     /// Whether a solve ran since `precompute` (`later_start`).
     solved_once: bool,
 }
 
 impl ScaleAware {
-    /// A method registered as `name` with the given parameters; call
-    /// [`DeformationMethod::precompute`] next.
+    /// A method registered as `name` with the given parameters and a memo of its own (it takes no
+    /// solve it did not compute); call [`DeformationMethod::precompute`] next.
     pub fn new(name: &'static str, params: ScaleAwareParams) -> Result<Self, MethodError> {
+        Self::sharing(name, params, SolveMemo::default())
+    }
+
+    /// [`ScaleAware::new`], keeping and looking up its solves in `memo`, which other instances may
+    /// share: a `scale_aware_ora` instance takes the solve of a `scale_aware` one with the same memo
+    /// where their inputs are identical ([`solve_memo`]).
+    pub fn sharing(
+        name: &'static str,
+        params: ScaleAwareParams,
+        memo: SolveMemo,
+    ) -> Result<Self, MethodError> {
         // Before the initialization is built from `initialization_omega`, so a bad value is named
         // by its own key.
         params.validate(name)?;
@@ -298,6 +313,7 @@ impl ScaleAware {
             flat_next: Vec::new(),
             timings: SolveTimings::default(),
             reused: None,
+            memo,
             solved_once: false,
         })
     }
@@ -646,7 +662,7 @@ impl DeformationMethod for ScaleAware {
             .positions(&self.current)
             .value(&rayon::current_num_threads())
             .finish();
-        let taken = if self.params.optimal_rigidity { solve_memo::find(key) } else { None };
+        let taken = if self.params.optimal_rigidity { self.memo.find(key) } else { None };
         let summary = match taken {
             Some(taken) => self.take(&taken, targets, observer)?,
             None => {
@@ -662,7 +678,7 @@ impl DeformationMethod for ScaleAware {
                         frames: self.frames.clone(),
                         seconds: start.elapsed().as_secs_f64(),
                     };
-                    solve_memo::store(key, solve);
+                    self.memo.store(key, solve);
                 }
                 summary
             }

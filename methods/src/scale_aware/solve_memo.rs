@@ -1,6 +1,12 @@
-//! The last few `scale_aware` solves of this process, by their inputs, so that `scale_aware_ora`
-//! (section 5.3: the same Algorithm 1, then the stitching) can take the result of an identical
-//! solve instead of computing it again.
+//! Recent `scale_aware` solves by their inputs, so that `scale_aware_ora` (section 5.3: the same
+//! Algorithm 1, then the stitching) can take the result of an identical solve instead of computing
+//! it again.
+//!
+//! A [`SolveMemo`] is held by each method instance: [`super::ScaleAware::new`] gives it one of its
+//! own, so an instance a library caller makes never takes anything it did not compute. Instances
+//! given one memo ([`super::ScaleAware::sharing`], [`crate::registry::create_sharing`]) take from
+//! each other: the harness gives one to every instance it makes, so that the `scale_aware_ora` case
+//! of a scenario takes the solve of its `scale_aware` case.
 //!
 //! A solve is identified by a 128-bit fingerprint of everything its result depends on: the rest
 //! mesh, the parameters of Algorithm 1 (all but `optimal_rigidity`), the constrained vertices, their
@@ -87,22 +93,41 @@ pub(super) struct MemoizedSolve {
     pub seconds: f64,
 }
 
-static SOLVES: Mutex<VecDeque<(Fingerprint, Arc<MemoizedSolve>)>> = Mutex::new(VecDeque::new());
+/// The solves a memo holds, newest last.
+type Entries = VecDeque<(Fingerprint, Arc<MemoizedSolve>)>;
 
-/// Keep `solve` under `key`, replacing an entry of the same key; the oldest entry goes when full.
-pub(super) fn store(key: Fingerprint, solve: MemoizedSolve) {
-    let mut solves = SOLVES.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-    solves.retain(|(k, _)| *k != key);
-    if solves.len() == CAPACITY {
-        solves.pop_front();
-    }
-    solves.push_back((key, Arc::new(solve)));
+/// A handle on a memo of recent solves; clones share it (see the module documentation). The
+/// default is a new, empty memo.
+#[derive(Clone, Default)]
+pub struct SolveMemo {
+    solves: Arc<Mutex<Entries>>,
 }
 
-/// The solve stored under `key`, if any.
-pub(super) fn find(key: Fingerprint) -> Option<Arc<MemoizedSolve>> {
-    let solves = SOLVES.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-    solves.iter().find(|(k, _)| *k == key).map(|(_, s)| Arc::clone(s))
+impl std::fmt::Debug for SolveMemo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SolveMemo").field("solves", &self.entries().len()).finish()
+    }
+}
+
+impl SolveMemo {
+    fn entries(&self) -> std::sync::MutexGuard<'_, Entries> {
+        self.solves.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// Keep `solve` under `key`, replacing an entry of the same key; the oldest entry goes when full.
+    pub(super) fn store(&self, key: Fingerprint, solve: MemoizedSolve) {
+        let mut solves = self.entries();
+        solves.retain(|(k, _)| *k != key);
+        if solves.len() == CAPACITY {
+            solves.pop_front();
+        }
+        solves.push_back((key, Arc::new(solve)));
+    }
+
+    /// The solve stored under `key`, if any.
+    pub(super) fn find(&self, key: Fingerprint) -> Option<Arc<MemoizedSolve>> {
+        self.entries().iter().find(|(k, _)| *k == key).map(|(_, s)| Arc::clone(s))
+    }
 }
 
 /// Forwards every report to `inner` and keeps a copy, with the iterate where `inner` asked for it;
