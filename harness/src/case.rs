@@ -57,9 +57,9 @@ impl EditStep for LoadedStep {
 pub(crate) fn repetition(
     scenario: &LoadedScenario,
     method: &ConfiguredMethod,
-    threads: usize,
+    settings: CaseSettings<'_>,
 ) -> Result<(Timings, Vec<[f64; 3]>), methods::MethodError> {
-    let mut m = method.create(None, threads)?;
+    let mut m = method.create(None, settings.threads, settings.solves)?;
     let startup_s = m.startup_seconds().unwrap_or(f64::NAN);
     let drive = drive(m.as_mut(), &scenario.mesh, &scenario.steps, &mut NoObserver);
     if let Some(failure) = drive.failure {
@@ -134,11 +134,13 @@ pub enum Reference<'a> {
 
 /// How the cases of a run are run.
 #[derive(Clone, Copy, Debug)]
-pub struct CaseSettings {
+pub struct CaseSettings<'a> {
     /// Worker threads (the pool the case runs in; an external method's thread variables).
     pub threads: usize,
     /// Measure the peak memory ([`crate::memory`]): only when one case runs at a time.
     pub measure_memory: bool,
+    /// The run's memo of solves, shared by its cases' instances ([`ConfiguredMethod::create`]).
+    pub solves: &'a methods::scale_aware::SolveMemo,
 }
 
 /// What the method instance said of itself once started.
@@ -167,14 +169,14 @@ pub fn run_case(
     rest: &RestGeometry,
     method: &ConfiguredMethod,
     stderr_log: Option<std::path::PathBuf>,
-    settings: CaseSettings,
+    settings: CaseSettings<'_>,
     rules: &VerdictRules,
     reference: Reference<'_>,
 ) -> CaseResult {
     let memory = (settings.measure_memory && method.origin == Origin::BuiltIn)
         .then(crate::memory::start_peak)
         .flatten();
-    let mut instance = match method.create(stderr_log, settings.threads) {
+    let mut instance = match method.create(stderr_log, settings.threads, settings.solves) {
         Ok(m) => m,
         Err(e) => {
             return CaseRecord { scenario, method, started: None, drive: None, trace: Vec::new() }.failed(e)
@@ -244,14 +246,8 @@ fn judge(
         Reference::Of { positions, finished } => (Some(positions), finished),
         Reference::Missing => (None, false),
     };
-    let quality = evaluate_on(
-        rest,
-        &scenario.mesh,
-        &scenario.topology,
-        positions,
-        (handles, &last.targets),
-        reference,
-    );
+    let quality =
+        evaluate_on(rest, &scenario.mesh, &scenario.topology, positions, (handles, &last.targets), reference);
     let rest_positions = scenario.mesh.positions();
     let largest_handle_move = (drive.steps.iter().zip(&scenario.steps))
         .flat_map(|(driven, step)| step.handles.constrained().zip(driven.targets.positions()))

@@ -89,12 +89,6 @@ impl std::fmt::Debug for Implementation {
     }
 }
 
-/// The memo of solves every built-in method instance of the process shares
-/// ([`methods::scale_aware::solve_memo`]): the `scale_aware_ora` case of a scenario edit step takes
-/// the identical solve of its `scale_aware` case instead of computing it again.
-static SHARED_SOLVES: std::sync::LazyLock<methods::scale_aware::SolveMemo> =
-    std::sync::LazyLock::new(Default::default);
-
 /// One method of a run.
 #[derive(Clone, Debug)]
 pub struct ConfiguredMethod {
@@ -120,11 +114,15 @@ pub struct ConfiguredMethod {
 
 impl ConfiguredMethod {
     /// A fresh instance; an external method's program is started (its stderr written to
-    /// `stderr_log`, its thread variables set to `threads`).
+    /// `stderr_log`, its thread variables set to `threads`). A built-in instance shares `solves`
+    /// ([`methods::scale_aware::solve_memo`]) with the others made with it: a run gives every case
+    /// its one memo, so that the `scale_aware_ora` case of an edit step takes the identical solve
+    /// of its `scale_aware` case instead of computing it again.
     pub fn create(
         &self,
         stderr_log: Option<PathBuf>,
         threads: usize,
+        solves: &methods::scale_aware::SolveMemo,
     ) -> Result<Box<dyn DeformationMethod>, MethodError> {
         if let Some(why) = &self.unavailable {
             return Err(MethodError::External {
@@ -133,7 +131,7 @@ impl ConfiguredMethod {
             });
         }
         match &self.implementation {
-            Implementation::BuiltIn(entry) => (entry.create)(&self.params, &SHARED_SOLVES),
+            Implementation::BuiltIn(entry) => (entry.create)(&self.params, solves),
             Implementation::External(e) => Ok(Box::new(ExternalMethod::start(ExternalSpec {
                 name: self.name.clone(),
                 program: e.program.clone(),

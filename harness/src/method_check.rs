@@ -48,7 +48,7 @@ pub fn check(method: &ConfiguredMethod) -> MethodCheck {
         }
     };
     let started = Instant::now();
-    let mut m = match method.create(None, 1) {
+    let mut m = match method.create(None, 1, &methods::scale_aware::SolveMemo::default()) {
         Ok(m) => m,
         Err(e) => {
             out.lines.push(format!("FAIL  start and hello: {e}"));

@@ -542,12 +542,13 @@ fn run_plan(
             .expect("static template")
             .progress_chars("=> "),
     );
-    let shared = SharedCases {
+    let mut shared = SharedCases {
         options,
         config,
         scenarios,
         rests: scenarios.iter().map(|_| OnceLock::new()).collect(),
         references: scenarios.iter().map(|_| OnceLock::new()).collect(),
+        solves: methods::scale_aware::SolveMemo::default(),
         reference_of: plan.iter().map(|ids| ids.iter().copied().find(is_reference)).collect(),
         bar: &bar,
     };
@@ -558,7 +559,7 @@ fn run_plan(
         case
     });
     let mut cases: Vec<(usize, MethodId, CaseResult)> = first.into_iter().flatten().collect();
-    let references = shared.references.into_iter().zip(&shared.reference_of).enumerate();
+    let references = std::mem::take(&mut shared.references).into_iter().zip(&shared.reference_of).enumerate();
     cases.extend(references.filter_map(|(s, (r, id))| Some((s, (*id)?, r.into_inner()?))));
     cases.sort_by_key(|(s, id, _)| (*s, plan[*s].iter().position(|m| m == id)));
     if rounds > 1 {
@@ -569,7 +570,7 @@ fn run_plan(
                 let (s, id, case) = &cases[i];
                 let method = id.of(&config.catalog);
                 let again = (!case.status.is_failed())
-                    .then(|| crate::case::repetition(&scenarios[*s], method, options.threads));
+                    .then(|| crate::case::repetition(&scenarios[*s], method, shared.settings()));
                 bar.inc(1);
                 again
             });
@@ -629,6 +630,8 @@ struct SharedCases<'a> {
     scenarios: &'a [LoadedScenario],
     rests: Vec<OnceLock<RestGeometry>>,
     references: Vec<OnceLock<CaseResult>>,
+    /// The run's memo of solves ([`CaseSettings::solves`]).
+    solves: methods::scale_aware::SolveMemo,
     /// The reference method of scenario `s`'s plan, if it runs it.
     reference_of: Vec<Option<MethodId>>,
     bar: &'a ProgressBar,
@@ -652,6 +655,15 @@ impl SharedCases<'_> {
         Some(self.run_case(s, method, reference))
     }
 
+    /// How this run's cases are run.
+    fn settings(&self) -> CaseSettings<'_> {
+        CaseSettings {
+            threads: self.options.threads,
+            measure_memory: self.options.jobs == 1,
+            solves: &self.solves,
+        }
+    }
+
     fn run_case(&self, s: usize, method: MethodId, reference: Reference<'_>) -> CaseResult {
         let scenario = &self.scenarios[s];
         let method = method.of(&self.config.catalog);
@@ -663,15 +675,7 @@ impl SharedCases<'_> {
                 crate::stored_report::case_file_stem(&scenario.spec.name, &method.name)
             ))
         });
-        run_case(
-            scenario,
-            rest,
-            method,
-            stderr_log,
-            CaseSettings { threads: self.options.threads, measure_memory: self.options.jobs == 1 },
-            &self.config.rules,
-            reference,
-        )
+        run_case(scenario, rest, method, stderr_log, self.settings(), &self.config.rules, reference)
     }
 }
 
