@@ -27,9 +27,10 @@ pub fn write_page(out: &Path, history: &History, store: &Path) -> Result<PathBuf
     std::fs::create_dir_all(&plots).map_err(|error| HistoryError::Io { path: plots.clone(), error })?;
     let cases = history.cases();
     let mut sections = String::new();
-    for (i, (series, scenario, method)) in cases.iter().enumerate() {
-        let timelines = history.case(series, scenario, method);
-        let stem = format!("{i:03}-{}", crate::stored_report::case_file_stem(scenario, method));
+    for (i, key) in cases.iter().enumerate() {
+        let timelines = history.case(key);
+        let stem =
+            format!("{i:03}-{}", crate::stored_report::case_file_stem(&key.case.scenario, &key.case.method));
         let png = PathBuf::from("plots").join(format!("{stem}.png"));
         draw_case(&out.join(&png), history, &timelines)?;
         section(&mut sections, history, &timelines, &png, i);

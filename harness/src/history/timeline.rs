@@ -11,6 +11,7 @@ use super::measures::Measure;
 use super::steps::{self, Observation};
 use super::store::{HistoryStore, StoredRun};
 use super::HistoryError;
+use crate::record::CaseKey;
 
 /// One point: a commit's value of the measure (or an uncommitted change's, [`CommitInfo::dirty`]).
 #[derive(Clone, Debug, PartialEq)]
@@ -53,6 +54,20 @@ pub struct Timeline {
     /// The fitted level of each point.
     pub fitted: Vec<f64>,
     pub steps: Vec<AttributedStep>,
+}
+
+/// Which case of which series a timeline follows.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct TimelineKey {
+    pub series: String,
+    pub case: CaseKey,
+}
+
+impl Timeline {
+    /// The case of the series it follows.
+    pub fn key(&self) -> TimelineKey {
+        TimelineKey { series: self.series.clone(), case: CaseKey::new(&self.scenario, &self.method) }
+    }
 }
 
 /// Every timeline of a store, over its commits.
@@ -306,21 +321,16 @@ fn status_changes(timelines: &[Timeline]) -> Vec<StatusChange> {
 
 impl History {
     /// The timelines of one case of one series, in [`Measure::all`] order.
-    pub fn case(&self, series: &str, scenario: &str, method: &str) -> Vec<&Timeline> {
-        let mut found: Vec<&Timeline> = self
-            .timelines
-            .iter()
-            .filter(|t| t.series == series && t.scenario == scenario && t.method == method)
-            .collect();
+    pub fn case(&self, key: &TimelineKey) -> Vec<&Timeline> {
+        let mut found: Vec<&Timeline> = self.timelines.iter().filter(|t| t.key() == *key).collect();
         let all = Measure::all();
         found.sort_by_key(|t| all.iter().position(|m| *m == t.measure));
         found
     }
 
-    /// The (series, scenario, method) cases, in order.
-    pub fn cases(&self) -> Vec<(String, String, String)> {
-        let mut cases: Vec<(String, String, String)> =
-            self.timelines.iter().map(|t| (t.series.clone(), t.scenario.clone(), t.method.clone())).collect();
+    /// The cases of every series, in order.
+    pub fn cases(&self) -> Vec<TimelineKey> {
+        let mut cases: Vec<TimelineKey> = self.timelines.iter().map(Timeline::key).collect();
         cases.dedup();
         cases
     }
