@@ -149,9 +149,10 @@ pub trait DeformationMethod: Send {
     }
 
     /// The part of the last [`solve`](Self::solve) that was not computed but taken from an earlier
-    /// identical solve of another method in this process (`scale_aware_ora` takes `scale_aware`'s):
-    /// its method and the seconds it took there. The wall time of `solve` does not include them; a
-    /// timer of the solve adds them, so that the reported time is that of the whole computation.
+    /// identical solve of another instance it shares a memo with (`scale_aware_ora` takes
+    /// `scale_aware`'s: `registry::create_sharing`): its method and the seconds it took there. The
+    /// wall time of `solve` does not include them; [`crate::drive::drive`] adds them, so that the
+    /// reported time is that of the whole computation.
     fn reused_solve(&self) -> Option<ReusedSolve> {
         None
     }
