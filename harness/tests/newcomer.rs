@@ -408,3 +408,32 @@ fn the_readme_scenario_example_parses_and_shows_up_repair_and_both_dmat_forms() 
         assert!(spec.repair && spec.up.is_some() && spec.regions.len() == 3, "{name}");
     }
 }
+
+/// `harness list | head -1`: the reader closes the pipe after its first line; the harness ends
+/// as Unix tools do, without a panic on the failed write. The listing is made longer than a pipe's
+/// buffer (2,000 scenarios), so that the harness is still writing when the pipe closes.
+#[test]
+fn a_closed_pipe_ends_the_listing_without_a_panic() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    let (code, _, stderr) = harness(&["configs", "export", dir.path().to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    let configs = dir.path().join("configs");
+    for i in 0..2000 {
+        bar_scenario(&configs.join("scenarios"), &format!("a-long-listing-{i:04}"), "");
+    }
+    let mut child = Command::new(env!("CARGO_BIN_EXE_harness"))
+        .args(["list", "--configs", configs.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().unwrap()).read_line(&mut first).unwrap();
+    // The reader is dropped here: the pipe is closed with most of the listing unwritten.
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(first.starts_with("methods"), "{first}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
