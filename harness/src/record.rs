@@ -392,8 +392,10 @@ fn nan_from_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error
 }
 
 impl CaseResult {
-    /// A case that has not run yet: no timings (NaN), no measures, status `ok`, no steps or positions.
-    pub fn empty(scenario: &str, method: &str, mesh_source: &str, vertices: usize, faces: usize) -> Self {
+    /// A case that has not run yet: no timings (NaN), no measures, status `ok`, no steps or
+    /// positions. For the reports' unit tests: a run builds its records in `case::CaseRecord::build`.
+    #[cfg(test)]
+    pub(crate) fn empty(scenario: &str, method: &str, mesh_source: &str, vertices: usize, faces: usize) -> Self {
         CaseResult {
             scenario: scenario.to_string(),
             method: method.to_string(),
