@@ -395,7 +395,13 @@ impl CaseResult {
     /// A case that has not run yet: no timings (NaN), no measures, status `ok`, no steps or
     /// positions. For the reports' unit tests: a run builds its records in `case::CaseRecord::build`.
     #[cfg(test)]
-    pub(crate) fn empty(scenario: &str, method: &str, mesh_source: &str, vertices: usize, faces: usize) -> Self {
+    pub(crate) fn empty(
+        scenario: &str,
+        method: &str,
+        mesh_source: &str,
+        vertices: usize,
+        faces: usize,
+    ) -> Self {
         CaseResult {
             scenario: scenario.to_string(),
             method: method.to_string(),
