@@ -117,13 +117,7 @@ fn materialize_built_in() -> Result<PathBuf, HarnessError> {
     if copy_is_whole(&dir) {
         return Ok(dir);
     }
-    let parent = dir.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(parent).map_err(|e| HarnessError::Io { path: parent.to_path_buf(), error: e })?;
-    let staging = tempfile::Builder::new()
-        .prefix(".staging-")
-        .tempdir_in(parent)
-        .map_err(|e| HarnessError::Io { path: parent.to_path_buf(), error: e })?;
-    write_built_in(staging.path())?;
+    let staging = staged_built_in(dir.parent().unwrap_or(Path::new(".")), ".staging-")?;
     if dir.exists() && !copy_is_whole(&dir) {
         // A damaged copy: replaced whole.
         std::fs::remove_dir_all(&dir).map_err(|e| HarnessError::Io { path: dir.clone(), error: e })?;
@@ -182,6 +176,18 @@ fn write_built_in(root: &Path) -> Result<usize, HarnessError> {
     Ok(built_in_files().len())
 }
 
+/// The built-in project files written whole into a new hidden directory `prefix…` inside `parent`
+/// (created if missing), to be moved into place; removed when dropped.
+fn staged_built_in(parent: &Path, prefix: &str) -> Result<tempfile::TempDir, HarnessError> {
+    std::fs::create_dir_all(parent).map_err(|e| HarnessError::Io { path: parent.to_path_buf(), error: e })?;
+    let staging = tempfile::Builder::new()
+        .prefix(prefix)
+        .tempdir_in(parent)
+        .map_err(|e| HarnessError::Io { path: parent.to_path_buf(), error: e })?;
+    write_built_in(staging.path())?;
+    Ok(staging)
+}
+
 /// `harness configs export DIR`: write the built-in project files into `dir` (created if missing),
 /// so that `harness` run from `dir` (or with `--configs DIR/configs`) reads them. Refuses, before
 /// writing anything, when any of the files already exists there (naming it). Returns the paths
@@ -198,12 +204,7 @@ pub fn export_built_in(dir: &Path) -> Result<Vec<PathBuf>, HarnessError> {
     // Written to a hidden staging directory inside `dir` and moved into place file by file only once
     // all were written, so a failure (a full disk) leaves no half-written file; the staging
     // directory is removed when it is dropped.
-    std::fs::create_dir_all(dir).map_err(|e| HarnessError::Io { path: dir.to_path_buf(), error: e })?;
-    let staging = tempfile::Builder::new()
-        .prefix(".deformbench-export-")
-        .tempdir_in(dir)
-        .map_err(|e| HarnessError::Io { path: dir.to_path_buf(), error: e })?;
-    write_built_in(staging.path())?;
+    let staging = staged_built_in(dir, ".deformbench-export-")?;
     for (relative, _) in built_in_files() {
         let (from, to) = (staging.path().join(relative), dir.join(relative));
         if let Some(parent) = to.parent() {
