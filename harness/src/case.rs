@@ -198,7 +198,7 @@ pub fn run_case(
         Some(failure) => Err(failure.error.to_string()),
     };
     let record =
-        CaseRecord { scenario, method, started: Some(started), drive: Some(&drive), trace: recorder.trace };
+        CaseRecord { scenario, method, started: Some(started), drive: Some(drive), trace: recorder.trace };
     record.build(peak_memory_mib, trace_quality_s, judged, &unfinished)
 }
 
@@ -275,12 +275,13 @@ fn judge(
     }
 }
 
-/// What a case's record is built from: who it is, what the instance said, the drive and its trace.
+/// What a case's record is built from: who it is, what the instance said, the drive (its final
+/// positions move into the record) and its trace.
 struct CaseRecord<'a> {
     scenario: &'a LoadedScenario,
     method: &'a ConfiguredMethod,
     started: Option<Started>,
-    drive: Option<&'a Drive>,
+    drive: Option<Drive>,
     trace: Vec<IterationRecord>,
 }
 
@@ -301,7 +302,9 @@ impl CaseRecord<'_> {
         unfinished: &[Unfinished],
     ) -> CaseResult {
         let (scenario, method) = (self.scenario, self.method);
-        let drive = self.drive;
+        let mut owned = self.drive;
+        let positions = owned.as_mut().map(|d| std::mem::take(&mut d.positions));
+        let drive = owned.as_ref();
         let ran_every_step = drive.is_some_and(|d| d.steps.len() == scenario.steps.len());
         let every_step = |value: f64| if ran_every_step { value } else { f64::NAN };
         let steps: &[DrivenStep] = drive.map_or(&[], |d| &d.steps);
@@ -357,7 +360,7 @@ impl CaseRecord<'_> {
                 evaluation_s: judged.as_ref().map_or(0.0, |j| j.evaluation_s),
             },
             spread: None,
-            positions: judged.is_some().then(|| drive.map(|d| d.positions.clone())).flatten(),
+            positions: positions.filter(|_| judged.is_some()),
         }
     }
 }
