@@ -95,11 +95,6 @@ impl Drive {
     pub fn reused_s(&self) -> f64 {
         self.steps.iter().filter_map(|s| s.reused.as_ref()).map(|r| r.seconds).sum()
     }
-
-    /// The method error that stopped it, if any.
-    pub fn error(&self) -> Option<&MethodError> {
-        self.failure.as_ref().map(|f| &f.error)
-    }
 }
 
 /// Run `method` through `steps` on `rest`: precompute, then bind and solve each step in order,
