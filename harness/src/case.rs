@@ -5,16 +5,15 @@ use std::ops::ControlFlow;
 use std::time::Instant;
 
 use crate::config::{ConfiguredMethod, Origin};
-use crate::metrics::{
-    angle_errors, asked_scale, asked_turn, evaluate_on, largest_displacement, Bends, Quality, RestGeometry,
-};
+pub use crate::verdict::Reference;
+use crate::metrics::{angle_errors, largest_displacement, Quality, RestGeometry};
 use crate::record::{
     records_quality, CaseResult, IterationRecord, MeasurementTime, ReusedSolveRecord, Spread, StepRecord,
     TimingSpread,
 };
 use crate::scenario::{LoadedScenario, LoadedStep};
 use crate::step_trend::StepTrend;
-use crate::verdict::{Motion, Status, Unfinished, VerdictRules};
+use crate::verdict::{Status, Unfinished, VerdictRules};
 use methods::drive::{drive, Drive, DrivenStep, EditStep};
 use methods::{HandleSet, HandleTargets, IterationObserver, IterationReport, NoObserver, Stopping};
 
@@ -118,18 +117,6 @@ impl IterationObserver for Recorder<'_> {
         self.trace.push(record);
         ControlFlow::Continue(())
     }
-}
-
-/// The result the distances to the reference method (`arap`) are measured against.
-#[derive(Clone, Copy, Debug)]
-pub enum Reference<'a> {
-    /// This case is the reference (its distances are 0).
-    Itself,
-    /// The reference's `#V x 3` result on the same scenario, and whether it finished (ok or
-    /// suspect: not an iterate stopped at its cap).
-    Of { positions: &'a [[f64; 3]], finished: bool },
-    /// No reference result (not run, or failed).
-    Missing,
 }
 
 /// How the cases of a run are run.
@@ -237,30 +224,17 @@ fn judge(
     reference: Reference<'_>,
 ) -> Judged {
     let start = Instant::now();
-    let positions = &drive.positions;
-    let last = drive.steps.last().expect("a scenario has at least one step");
-    let handles = &scenario.steps[drive.steps.len() - 1].handles;
-    let (reference, reference_finished) = match reference {
-        // Its own verdict does not wait for itself; its turn against itself is 0.
-        Reference::Itself => (Some(&positions[..]), true),
-        Reference::Of { positions, finished } => (Some(positions), finished),
-        Reference::Missing => (None, false),
-    };
-    let quality =
-        evaluate_on(rest, &scenario.mesh, &scenario.topology, positions, (handles, &last.targets), reference);
-    let rest_positions = scenario.mesh.positions();
-    let largest_handle_move = (drive.steps.iter().zip(&scenario.steps))
-        .flat_map(|(driven, step)| step.handles.constrained().zip(driven.targets.positions()))
-        .map(|(v, t)| meshes::vector::norm(meshes::vector::sub(*t, rest_positions[v as usize])))
-        .fold(0.0f64, f64::max);
-    let motion = Motion {
-        largest_move: largest_displacement(rest_positions, positions) / rest.diagonal,
-        largest_handle_move: largest_handle_move / rest.diagonal,
-        asked_turn_deg: asked_turn(rest_positions, handles, &last.targets, Bends::FromHeld).to_degrees(),
-        asked_scale: asked_scale(rest_positions, handles, &last.targets),
-        reference_finished,
-    };
-    let mut reasons = rules.reasons(&quality, motion);
+    let steps: Vec<(&HandleSet, &HandleTargets)> =
+        scenario.steps.iter().zip(&drive.steps).map(|(step, driven)| (&step.handles, &driven.targets)).collect();
+    let measures::Judgement { quality, motion, mut reasons } = measures::judge_on(
+        rules,
+        rest,
+        &scenario.mesh,
+        &scenario.topology,
+        &drive.positions,
+        &steps,
+        reference,
+    );
     // A process that outlived its case is the case's to say (the token kill missed it).
     reasons.extend(instance.end());
     if drive.steps.iter().any(|s| s.summary.convergence_unknown) {

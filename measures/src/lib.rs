@@ -33,6 +33,7 @@ pub mod evaluation;
 pub mod metric;
 pub mod quality;
 pub mod rest;
+pub mod size;
 pub mod statistics;
 pub mod status;
 pub mod step_trend;
@@ -49,7 +50,7 @@ pub use quality::Quality;
 pub use rest::RestGeometry;
 pub use status::{Status, Unfinished, STATUS_KINDS};
 pub use step_trend::StepTrend;
-pub use verdict::{reason_kind, Motion, VerdictRules, REASON_KINDS};
+pub use verdict::{reason_kind, Motion, Reference, VerdictRules, REASON_KINDS};
 
 /// Every measure of a deformation result against its rest mesh.
 ///
@@ -132,6 +133,82 @@ pub fn evaluate_on(
     reference: Option<&[[f64; 3]]>,
 ) -> Quality {
     Quality::evaluate(&Evaluation::new(rest, mesh, topology, result, (handles, targets), reference))
+}
+
+/// A result judged: its measures, what the verdict read beside them, and the reasons it is
+/// suspect (empty: `ok`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Judgement {
+    pub quality: Quality,
+    pub motion: Motion,
+    pub reasons: Vec<String>,
+}
+
+/// Measure `result` and judge it by `rules`: [`evaluate`]'s inputs, with `reference` (if any)
+/// taken as a finished reference result on the same edit (`Some(result)` itself: the reference
+/// judged).
+///
+/// # Errors
+///
+/// As [`evaluate`].
+#[allow(clippy::too_many_arguments)]
+pub fn judge<H: AsRef<[usize]>, T: AsRef<[[f64; 3]]>>(
+    rules: &VerdictRules,
+    rest: &[[f64; 3]],
+    faces: &[[usize; 3]],
+    result: &[[f64; 3]],
+    fixed: &[usize],
+    handles: &[H],
+    targets: &[T],
+    reference: Option<&[[f64; 3]]>,
+) -> Result<Judgement, MeasuresError> {
+    let triangles = faces
+        .iter()
+        .enumerate()
+        .map(|(f, t)| {
+            let whose = || format!("face {f}");
+            Ok([index(t[0], whose)?, index(t[1], whose)?, index(t[2], whose)?])
+        })
+        .collect::<Result<Vec<[u32; 3]>, MeasuresError>>()?;
+    let mesh = TriMesh::new(rest.to_vec(), triangles)?;
+    let topology = Topology::new(&mesh)?;
+    check_size("result", result.len(), rest.len())?;
+    if let Some(reference) = reference {
+        check_size("reference", reference.len(), rest.len())?;
+    }
+    let (handles, targets) = edit(rest, fixed, handles, targets)?;
+    let geometry = RestGeometry::new(&mesh, &topology);
+    let reference = match reference {
+        Some(r) if r == result => Reference::Itself,
+        Some(positions) => Reference::Of { positions, finished: true },
+        None => Reference::Missing,
+    };
+    Ok(judge_on(rules, &geometry, &mesh, &topology, result, &[(&handles, &targets)], reference))
+}
+
+/// [`judge`] for a caller that judges many results on one rest mesh (the harness), as
+/// [`evaluate_on`]: `steps` are the edit's steps (handle set and targets; the last is measured,
+/// all of them bound how far a handle moved), `reference` the result judged beside.
+pub fn judge_on(
+    rules: &VerdictRules,
+    rest: &RestGeometry,
+    mesh: &TriMesh,
+    topology: &Topology,
+    result: &[[f64; 3]],
+    steps: &[(&HandleSet, &HandleTargets)],
+    reference: Reference<'_>,
+) -> Judgement {
+    let last = *steps.last().expect("an edit has at least one step");
+    let positions = match reference {
+        // The reference's distances and turn to itself are 0.
+        Reference::Itself => Some(result),
+        Reference::Of { positions, .. } => Some(positions),
+        Reference::Missing => None,
+    };
+    let quality = evaluate_on(rest, mesh, topology, result, last, positions);
+    let motion = Motion::of(rest, mesh, result, steps, reference);
+    let reasons = rules.reasons(&quality, motion);
+    Judgement { quality, motion, reasons }
 }
 
 /// `fixed` and the `handles` as a handle set on `rest.len()` vertices (`fixed` first, as the

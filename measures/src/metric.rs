@@ -9,11 +9,13 @@ use std::fmt;
 use crate::distance::{handle_residual, max_distance, rms_distance};
 use crate::distortion::{area_change, area_distortion, length_distortion, volume_change};
 use crate::evaluation::Evaluation;
-use crate::turn::{turn_beyond_handles, turn_to_reference};
+use crate::size::{isometric_distortion, resized_shares};
+use crate::turn::{turn_beyond_handles, turn_to_reference, turned_share};
 
 /// Every measure of a result. The order is the column order of the reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Metric {
+    EIso,
     ETheta,
     EPhi,
     EArea,
@@ -22,6 +24,9 @@ pub enum Metric {
     VolumeChange,
     Folds,
     TurnBeyondHandles,
+    TurnedShare,
+    ShrunkShare,
+    SwollenShare,
     HandleResidual,
     RmsToArap,
     MaxToArap,
@@ -99,7 +104,22 @@ pub struct MetricSpec {
 }
 
 /// The metric table, in [`Metric`] order.
-pub const METRICS: [MetricSpec; 13] = [
+pub const METRICS: [MetricSpec; 17] = [
+    MetricSpec {
+        metric: Metric::EIso,
+        key: "e_iso",
+        label: "e_iso",
+        unit: "",
+        doc: "isometric distortion: RMS over faces (weighted by rest area) of the logs of the two singular \
+              values of each face's deformation gradient, sqrt(Σ A⁰ (ln² σ₁ + ln² σ₂) / 2 / Σ A⁰); 0 for a \
+              rigid motion, |ln s| for a uniform scaling by s: it sees size and angle together, and the \
+              page ranks by it",
+        better: Better::Lower,
+        gate: Some(Tolerance { relative: 0.02, absolute: 0.001 }),
+        plotted: true,
+        format: Format::Fixed(4),
+        compute: |e| Some(isometric_distortion(e)),
+    },
     MetricSpec {
         metric: Metric::ETheta,
         key: "e_theta_deg",
@@ -204,6 +224,47 @@ pub const METRICS: [MetricSpec; 13] = [
         compute: |e| Some(turn_beyond_handles(e).to_degrees()),
     },
     MetricSpec {
+        metric: Metric::TurnedShare,
+        key: "turned_share",
+        label: "turned",
+        unit: "",
+        doc: "share of the free surface (rest vertex areas) whose one-ring turned more than 45° beyond what \
+              the handles ask (as for turn): a patch turned on its own, however small a share",
+        better: Better::Lower,
+        // Not gated: a verdict rule (configs/verdicts.toml) judges it.
+        gate: None,
+        plotted: false,
+        format: Format::Percent(1),
+        compute: |e| Some(turned_share(e)),
+    },
+    MetricSpec {
+        metric: Metric::ShrunkShare,
+        key: "shrunk_share",
+        label: "shrunk",
+        unit: "",
+        doc: "share of the rest surface area on faces whose area fell more than a factor 1.2 below what \
+              the handles ask (per region from its own motion; a bend asks none) and below the same face \
+              in the arap result",
+        better: Better::Lower,
+        gate: None,
+        plotted: false,
+        format: Format::Percent(1),
+        compute: |e| Some(resized_shares(e).0),
+    },
+    MetricSpec {
+        metric: Metric::SwollenShare,
+        key: "swollen_share",
+        label: "swollen",
+        unit: "",
+        doc: "share of the rest surface area on faces whose area grew more than a factor 1.2 beyond what \
+              the handles ask and beyond the same face in the arap result",
+        better: Better::Lower,
+        gate: None,
+        plotted: false,
+        format: Format::Percent(1),
+        compute: |e| Some(resized_shares(e).1),
+    },
+    MetricSpec {
         metric: Metric::HandleResidual,
         key: "handle_residual_over_diag",
         label: "residual",
@@ -276,7 +337,8 @@ pub const METRICS: [MetricSpec; 13] = [
 
 impl Metric {
     /// Every metric, in table order.
-    pub const ALL: [Metric; 13] = [
+    pub const ALL: [Metric; 17] = [
+        Metric::EIso,
         Metric::ETheta,
         Metric::EPhi,
         Metric::EArea,
@@ -285,6 +347,9 @@ impl Metric {
         Metric::VolumeChange,
         Metric::Folds,
         Metric::TurnBeyondHandles,
+        Metric::TurnedShare,
+        Metric::ShrunkShare,
+        Metric::SwollenShare,
         Metric::HandleResidual,
         Metric::RmsToArap,
         Metric::MaxToArap,

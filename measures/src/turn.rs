@@ -34,6 +34,42 @@ pub fn turn_beyond_handles(e: &Evaluation) -> f64 {
     (percentile(free, TURN_PERCENTILE) - asked_turn(rest, e.handles, e.targets, Bends::All)).max(0.0)
 }
 
+/// How far beyond what the handles ask a one-ring may turn before [`turned_share`] counts it
+/// (degrees): the same 45 deg as the verdict's `max_turn_beyond_handles_deg`.
+pub const TURNED_MARGIN_DEG: f64 = 45.0;
+
+/// The share of the free surface (rest vertex areas, a third of each incident face's) whose
+/// one-ring turned more than [`TURNED_MARGIN_DEG`] beyond what the handles ask ([`asked_turn`]).
+/// Issue 62: [`turn_beyond_handles`] reads a 90th percentile, so a turned patch smaller than a
+/// tenth of the free surface passed; this sees any patch, and the verdict sets a floor on its
+/// share so that a few noisy one-rings do not count.
+pub fn turned_share(e: &Evaluation) -> f64 {
+    let rest = e.mesh.positions();
+    let turns = one_ring_turns(rest, e.result, e.topology);
+    let region_of = e.handles.region_of();
+    let limit = asked_turn(rest, e.handles, e.targets, Bends::All) + TURNED_MARGIN_DEG.to_radians();
+    let mut vertex_area = vec![0.0; rest.len()];
+    for (t, a) in e.mesh.triangles().iter().zip(&e.rest.areas) {
+        for &v in t {
+            vertex_area[v as usize] += a / 3.0;
+        }
+    }
+    let (mut turned, mut free) = (0.0, 0.0);
+    for (v, turn) in turns.iter().enumerate() {
+        if region_of[v] == methods::handles::FREE {
+            free += vertex_area[v];
+            if *turn > limit {
+                turned += vertex_area[v];
+            }
+        }
+    }
+    if free > 0.0 {
+        turned / free
+    } else {
+        0.0
+    }
+}
+
 /// Edge of the cubes [`turn_to_reference`] fits its rotations in, over the rest bbox diagonal:
 /// large enough that a cube holds a patch of surface whose turn is the part's, not the noise of
 /// single one-rings (fitted per one-ring, two sound results of a noisy scan differ by 16-45 deg at

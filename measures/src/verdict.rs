@@ -14,9 +14,18 @@ use std::path::Path;
 
 use serde::Deserialize;
 
+use meshes::vector::{norm, sub};
+use meshes::TriMesh;
+use methods::{HandleSet, HandleTargets};
+
+use crate::distance::largest_displacement;
+use crate::distortion::{area_change, volume_change};
 use crate::error::MeasuresError;
 use crate::metric::Metric;
 use crate::quality::Quality;
+use crate::rest::RestGeometry;
+use crate::size::{asked_size, AskedSize};
+use crate::turn::{asked_turn, Bends};
 
 /// The kinds of shape reasons [`VerdictRules::reasons`] gives, each the start of its text (the
 /// dataset report counts cases per kind).
@@ -53,12 +62,19 @@ pub struct VerdictRules {
     pub max_turn_to_arap_of_asked: f64,
     /// ... but never below this many degrees.
     pub min_turn_to_arap_allowed_deg: f64,
-    /// How far the total surface area may leave the range the handles ask (`Motion::asked_scale`
-    /// squared, and no change), as a fraction: `swells` above, `shrinks` below.
+    /// How far the total surface area may leave the range the handles ask ([`Motion::asked_size`],
+    /// widened by the reference's own change), as a fraction: `swells` above, `shrinks` below. The
+    /// enclosed volume of a closed mesh is judged with the same margin on lengths (its power 3/2).
     pub max_area_change_beyond_asked: f64,
+    /// Largest `shrunk_share` or `swollen_share` (share of the surface resized beyond what is asked)
+    /// that is still `ok`.
+    pub max_resized_share: f64,
+    /// Largest `turned_share` (share of the free surface turned 45° beyond what is asked) that is
+    /// still `ok`.
+    pub max_turned_share: f64,
 }
 
-/// What a verdict reads of a case besides its measures.
+/// What a verdict reads of a case besides its measures ([`Motion::of`] builds it).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Motion {
     /// The largest distance of any result vertex from its rest position, over the rest diagonal.
@@ -69,13 +85,68 @@ pub struct Motion {
     /// The turn the last step's handles ask of the free surface (degrees,
     /// [`crate::turn::asked_turn`] with bends from the held regions only).
     pub asked_turn_deg: f64,
-    /// The scale the last step's handles ask ([`crate::turn::asked_scale`]): 1 for rigid handle
-    /// motions, above 1 where they pull regions apart.
-    pub asked_scale: f64,
+    /// The area factors the last step's handles ask, per region from its own motion
+    /// ([`crate::size::asked_size`]): 1 for rigid motions and bends.
+    pub asked_size: AskedSize,
+    /// The reference's own `(A / A⁰, V / V⁰)` on the same edit, where it finished and is another
+    /// result than this one: a size the edit needed of the reference is not held against others.
+    pub reference_size: Option<(f64, Option<f64>)>,
     /// The scenario's reference (`arap`) finished (ok or suspect), so its result judges this one's
     /// turns (`turn_to_arap_deg`); an unfinished reference is an iterate, and then only the result's
     /// own measures judge it (`turn_beyond_handles_deg` among them).
     pub reference_finished: bool,
+}
+
+/// The result a case is judged beside.
+#[derive(Clone, Copy, Debug)]
+pub enum Reference<'a> {
+    /// This result is the reference: its distances and turn to it are 0, and nothing but the
+    /// handles' asking judges its size.
+    Itself,
+    /// The reference's `#V x 3` result on the same edit, and whether it finished (ok or suspect:
+    /// not an iterate stopped at its cap).
+    Of { positions: &'a [[f64; 3]], finished: bool },
+    /// No reference result (not run, or failed).
+    Missing,
+}
+
+impl Motion {
+    /// The motion of `result` (`#V x 3`) on the rest `mesh` (with `rest_geometry`) under the
+    /// edit `steps` (each step's handle set and targets; the last is judged), beside `reference`.
+    pub fn of<'s>(
+        rest_geometry: &RestGeometry,
+        mesh: &TriMesh,
+        result: &[[f64; 3]],
+        steps: &[(&'s HandleSet, &'s HandleTargets)],
+        reference: Reference<'_>,
+    ) -> Motion {
+        let rest = mesh.positions();
+        let largest_handle_move = steps
+            .iter()
+            .flat_map(|(handles, targets)| handles.constrained().zip(targets.positions()))
+            .map(|(v, t)| norm(sub(*t, rest[v as usize])))
+            .fold(0.0f64, f64::max);
+        let (handles, targets) = *steps.last().expect("an edit has at least one step");
+        let (reference_size, reference_finished) = match reference {
+            Reference::Itself => (None, true),
+            Reference::Of { positions, finished } => (finished.then(|| size_factors(rest_geometry, mesh, positions)), finished),
+            Reference::Missing => (None, false),
+        };
+        Motion {
+            largest_move: largest_displacement(rest, result) / rest_geometry.diagonal,
+            largest_handle_move: largest_handle_move / rest_geometry.diagonal,
+            asked_turn_deg: asked_turn(rest, handles, targets, Bends::FromHeld).to_degrees(),
+            asked_size: asked_size(rest, handles, targets),
+            reference_size,
+            reference_finished,
+        }
+    }
+}
+
+/// `(A / A⁰, V / V⁰)` of `result` on `mesh` against its `rest` geometry (the volume where
+/// [`volume_change`] has one: closed meshes).
+fn size_factors(rest: &RestGeometry, mesh: &TriMesh, result: &[[f64; 3]]) -> (f64, Option<f64>) {
+    (1.0 + area_change(rest, mesh, result), volume_change(rest, mesh, result).map(|v| 1.0 + v))
 }
 
 impl VerdictRules {
@@ -93,6 +164,8 @@ impl VerdictRules {
             ("max_turn_to_arap_of_asked", rules.max_turn_to_arap_of_asked),
             ("min_turn_to_arap_allowed_deg", rules.min_turn_to_arap_allowed_deg),
             ("max_area_change_beyond_asked", rules.max_area_change_beyond_asked),
+            ("max_resized_share", rules.max_resized_share),
+            ("max_turned_share", rules.max_turned_share),
         ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(config(format!("`{name}` must be a finite number >= 0, not {value}")));
@@ -104,8 +177,7 @@ impl VerdictRules {
     /// The reasons a finished case with `quality` and `motion` is suspect (empty: `ok`). A result is
     /// judged on itself, and against the reference's result only where that finished.
     pub fn reasons(&self, quality: &Quality, motion: Motion) -> Vec<String> {
-        let Motion { largest_move, largest_handle_move, asked_turn_deg, asked_scale, reference_finished } =
-            motion;
+        let Motion { largest_move, largest_handle_move, asked_turn_deg, reference_finished, .. } = motion;
         let mut reasons = Vec::new();
         let non_finite: Vec<&str> = quality.non_finite().map(Metric::key).collect();
         if !non_finite.is_empty() || !largest_move.is_finite() {
@@ -134,6 +206,14 @@ impl VerdictRules {
                  (> {:.0}°)",
                 self.max_turn_beyond_handles_deg
             ));
+        } else if let Some(share) = quality.get(Metric::TurnedShare).filter(|s| *s > self.max_turned_share) {
+            reasons.push(format!(
+                "turns a free region: {:.1}% of its free surface turned more than {:.0}° beyond what the handles \
+                 ask (> {:.1}%)",
+                100.0 * share,
+                crate::turn::TURNED_MARGIN_DEG,
+                100.0 * self.max_turned_share
+            ));
         }
         let allowed =
             (self.max_turn_to_arap_of_asked * asked_turn_deg).max(self.min_turn_to_arap_allowed_deg);
@@ -144,33 +224,70 @@ impl VerdictRules {
                 self.max_turn_to_arap_of_asked
             ));
         }
-        if let Some(change) = quality.get(Metric::AreaChange).filter(|c| c.is_finite()) {
-            // Judged on ln(A / A⁰) against [2 ln min(s, 1), 2 ln max(s, 1)]: a method may keep the area
-            // or scale it as the handles do, and no further.
-            let (ratio, margin) = (1.0 + change, (1.0 + self.max_area_change_beyond_asked).ln());
-            let (low, high) = (asked_scale.min(1.0).powi(2), asked_scale.max(1.0).powi(2));
-            let beyond = if ratio > 0.0 && ratio.ln() - high.ln() > margin {
-                Some(("swells", "grew", "at most", high))
-            } else if ratio <= 0.0 || low.ln() - ratio.ln() > margin {
-                Some(("shrinks", "fell", "at least", low))
-            } else {
-                None
-            };
-            if let Some((kind, went, bound, asked)) = beyond {
-                reasons.push(format!(
-                    "{kind}: its surface area {went} {:+.0}% where the handles ask {bound} {:+.0}% \
-                     (> {:.0}% beyond)",
-                    100.0 * (ratio - 1.0),
-                    100.0 * (asked - 1.0),
-                    100.0 * self.max_area_change_beyond_asked
-                ));
-            }
-        }
+        reasons.extend(self.size_reasons(quality, motion));
         let allowed = largest_handle_move + self.frame_margin_diagonals;
         if largest_move > allowed {
             reasons.push(format!(
                 "leaves its frame: a vertex moved {largest_move:.2} diagonals (handles at most {largest_handle_move:.2})"
             ));
+        }
+        reasons
+    }
+
+    /// The `shrinks` and `swells` reasons: the total area (and a closed mesh's volume) against the
+    /// size the handles ask, widened by the reference's own change; else the share of the surface
+    /// resized in places.
+    fn size_reasons(&self, quality: &Quality, motion: Motion) -> Vec<String> {
+        let margin = (1.0 + self.max_area_change_beyond_asked).ln();
+        let (reference_area, reference_volume) = match motion.reference_size {
+            Some((area, volume)) => (Some(area), volume),
+            None => (None, None),
+        };
+        let measured = [
+            ("surface area", Metric::AreaChange, motion.asked_size.with(reference_area), reference_area, margin),
+            ("volume", Metric::VolumeChange, motion.asked_size.volume().with(reference_volume), reference_volume, 1.5 * margin),
+        ];
+        let mut totals: Vec<(&str, String)> = Vec::new();
+        for (what, metric, range, beside, margin) in measured {
+            let Some(factor) = quality.get(metric).filter(|c| c.is_finite()).map(|c| 1.0 + c) else { continue };
+            let beyond = range.beyond(factor);
+            let kind = if beyond < -margin {
+                "shrinks"
+            } else if beyond > margin {
+                "swells"
+            } else {
+                continue;
+            };
+            let asked = if range.low == 1.0 && range.high == 1.0 && beside.is_none() {
+                "no change".to_string()
+            } else {
+                format!("{:+.0}% to {:+.0}%", 100.0 * (range.low - 1.0), 100.0 * (range.high - 1.0))
+            };
+            let beside = beside.map_or(String::new(), |r| format!(", arap's {:+.1}% among them", 100.0 * (r - 1.0)));
+            let went = if kind == "shrinks" { "fell" } else { "grew" };
+            totals.push((kind, format!("its {what} {went} {:+.0}% where {asked} is asked{beside}", 100.0 * (factor - 1.0))));
+        }
+        let mut reasons = Vec::new();
+        for kind in ["shrinks", "swells"] {
+            let parts: Vec<&str> = totals.iter().filter(|(k, _)| *k == kind).map(|(_, t)| t.as_str()).collect();
+            if !parts.is_empty() {
+                reasons.push(format!(
+                    "{kind}: {} (> {:.0}% beyond)",
+                    parts.join("; "),
+                    100.0 * self.max_area_change_beyond_asked
+                ));
+                continue;
+            }
+            let (metric, went) = if kind == "shrinks" { (Metric::ShrunkShare, "lost") } else { (Metric::SwollenShare, "gained") };
+            if let Some(share) = quality.get(metric).filter(|s| *s > self.max_resized_share) {
+                reasons.push(format!(
+                    "{kind} in places: {:.1}% of its surface {went} more than a factor {:.1} of area beyond what \
+                     is asked and beyond arap's there (> {:.1}%)",
+                    100.0 * share,
+                    crate::size::LOCAL_AREA_MARGIN,
+                    100.0 * self.max_resized_share
+                ));
+            }
         }
         reasons
     }
@@ -189,6 +306,8 @@ mod tests {
             max_turn_to_arap_of_asked: 0.4,
             min_turn_to_arap_allowed_deg: 5.0,
             max_area_change_beyond_asked: 0.25,
+            max_resized_share: 0.05,
+            max_turned_share: 0.02,
         }
     }
 
@@ -199,7 +318,8 @@ mod tests {
             largest_move,
             largest_handle_move: 0.2,
             asked_turn_deg: 50.0,
-            asked_scale: 1.0,
+            asked_size: AskedSize::NONE,
+            reference_size: None,
             reference_finished: true,
         }
     }
@@ -261,7 +381,7 @@ mod tests {
             reasons.len() == 1 && reasons[0].starts_with("swells: its surface area grew +26%"),
             "{reasons:?}"
         );
-        let stretched = Motion { asked_scale: 1.2, ..moved(0.3) };
+        let stretched = Motion { asked_size: AskedSize { low: 1.0, high: 1.44 }, ..moved(0.3) };
         area.set(Metric::AreaChange, Some(0.7));
         assert!(r.reasons(&area, stretched).is_empty(), "1.44 x 1.25 = 1.8");
         area.set(Metric::AreaChange, Some(0.85));
@@ -311,7 +431,7 @@ mod tests {
             &path,
             "max_folds = -1\nmax_handle_residual_over_diag = 1e-3\nframe_margin_diagonals = 1\n\
              max_turn_beyond_handles_deg = 45\nmax_turn_to_arap_of_asked = 0.4\nmin_turn_to_arap_allowed_deg = 5\n\
-             max_area_change_beyond_asked = 0.25\n",
+             max_area_change_beyond_asked = 0.25\nmax_resized_share = 0.05\nmax_turned_share = 0.02\n",
         )
         .unwrap();
         let e = VerdictRules::load(&path).unwrap_err().to_string();

@@ -1,0 +1,300 @@
+//! Size: what the handles ask of the size of the surface ([`asked_size`], per handle region from
+//! its own motion), how each face changed size and shape ([`face_stretches`], the singular values
+//! of its deformation gradient), the isometric distortion they give ([`isometric_distortion`]), and
+//! the share of the surface that shrank or swelled beyond what is asked ([`resized_shares`]).
+//!
+//! Issue 62: the verdicts used to take the asked scale from the spread of all handle targets, so
+//! the survey cylinder's bend, which brings its ends together, "asked" a scale of 0.52 and results
+//! that lost a third of their area were `ok`; and they read only the total area, so a patch shrunk
+//! or swollen while the total held was never seen.
+
+use meshes::vector::{cross, dot, norm, sub};
+use methods::{HandleSet, HandleTargets};
+
+use crate::evaluation::Evaluation;
+
+/// The range of area factors (`A / A⁰`) the handles ask of the surface. Decision (issue 62), per
+/// handle region from its own motion:
+///
+/// - a region moved rigidly asks no change of size; a region scaled about its centroid by `s`
+///   (the RMS distance of its targets from their centroid over that of its rest positions) asks
+///   `s²`;
+/// - two regions whose centroids moved apart by a factor `k > 1` ask the surface between them to
+///   stretch, up to `k²` (a method that keeps shapes up to scale, scale_aware eq 3, scales it
+///   uniformly);
+/// - two regions brought together ask no shrink: the surface between them can bend (the survey
+///   cylinder's and cactus's bends) or bulge, and a length-keeping method does so.
+///
+/// So `low = min(1, min_r s_r)²` and `high = max(1, max_r s_r, max_rr' k_rr')²`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AskedSize {
+    /// The smallest area factor asked (`<= 1`).
+    pub low: f64,
+    /// The largest area factor asked (`>= 1`).
+    pub high: f64,
+}
+
+impl AskedSize {
+    /// No change of size asked.
+    pub const NONE: AskedSize = AskedSize { low: 1.0, high: 1.0 };
+
+    /// The range with `factor` (an area factor, e.g. the reference result's) taken in; a
+    /// non-finite or non-positive factor is left out.
+    pub fn with(self, factor: Option<f64>) -> AskedSize {
+        match factor.filter(|f| f.is_finite() && *f > 0.0) {
+            Some(f) => AskedSize { low: self.low.min(f), high: self.high.max(f) },
+            None => self,
+        }
+    }
+
+    /// How far (in `ln`) the area factor `factor` lies beyond this range: negative beyond
+    /// `low` (shrunk), positive beyond `high` (swollen), 0 inside; `-inf` for a collapsed area.
+    pub fn beyond(self, factor: f64) -> f64 {
+        let ln = if factor > 0.0 { factor.ln() } else { f64::NEG_INFINITY };
+        if ln < self.low.ln() {
+            ln - self.low.ln()
+        } else if ln > self.high.ln() {
+            ln - self.high.ln()
+        } else {
+            0.0
+        }
+    }
+
+    /// The same range for a volume: each area factor `a` as `a^(3/2)`.
+    pub fn volume(self) -> AskedSize {
+        AskedSize { low: self.low.powf(1.5), high: self.high.powf(1.5) }
+    }
+}
+
+/// The range of area factors the last step's `handles` (with `targets`, on the `#V x 3` `rest`
+/// positions) ask: see [`AskedSize`]. No handle region, or regions of one point each, ask none.
+pub fn asked_size(rest: &[[f64; 3]], handles: &HandleSet, targets: &HandleTargets) -> AskedSize {
+    let mut target_of = vec![None; rest.len()];
+    for (v, t) in handles.constrained().zip(targets.positions()) {
+        target_of[v as usize] = Some(*t);
+    }
+    // Per region: its rest and target centroids and its own scale.
+    let regions: Vec<([f64; 3], [f64; 3], f64)> = handles
+        .regions()
+        .iter()
+        .filter_map(|r| {
+            let pairs: Vec<([f64; 3], [f64; 3])> = r
+                .vertices
+                .iter()
+                .filter_map(|&v| target_of[v as usize].map(|t| (rest[v as usize], t)))
+                .collect();
+            (!pairs.is_empty()).then(|| {
+                let (c0, c1) = centroids(&pairs);
+                let spread0: f64 = pairs.iter().map(|(p, _)| norm(sub(*p, c0)).powi(2)).sum();
+                let spread1: f64 = pairs.iter().map(|(_, t)| norm(sub(*t, c1)).powi(2)).sum();
+                let scale = if spread0 > 0.0 && spread1.is_finite() { (spread1 / spread0).sqrt() } else { 1.0 };
+                (c0, c1, scale)
+            })
+        })
+        .collect();
+    let (mut low, mut high) = (1.0f64, 1.0f64);
+    for (i, (c0, c1, s)) in regions.iter().enumerate() {
+        low = low.min(*s);
+        high = high.max(*s);
+        for (d0, d1, _) in &regions[i + 1..] {
+            let apart0 = norm(sub(*c0, *d0));
+            let apart1 = norm(sub(*c1, *d1));
+            if apart0 > 0.0 && apart1.is_finite() {
+                high = high.max(apart1 / apart0);
+            }
+        }
+    }
+    AskedSize { low: low * low, high: high * high }
+}
+
+/// The centroids of the rest and target points of `pairs` (not empty).
+fn centroids(pairs: &[([f64; 3], [f64; 3])]) -> ([f64; 3], [f64; 3]) {
+    let n = pairs.len() as f64;
+    let (mut c0, mut c1) = ([0.0; 3], [0.0; 3]);
+    for (p, t) in pairs {
+        for a in 0..3 {
+            c0[a] += p[a] / n;
+            c1[a] += t[a] / n;
+        }
+    }
+    (c0, c1)
+}
+
+/// Per face of `triangles` (`#F x 3`), the singular values `[σ_max, σ_min]` of the deformation
+/// gradient that maps its `rest` triangle onto its `result` triangle (both `#V x 3`): the largest
+/// and smallest factor by which it stretched a direction in its plane. `σ_max σ_min` is its area
+/// factor; both are 1 for a rigid motion and `s` for a uniform scaling by `s`. `None` for a rest
+/// face of zero area (it has no plane).
+pub fn face_stretches(
+    rest: &[[f64; 3]],
+    result: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+) -> Vec<Option<[f64; 2]>> {
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| v as usize);
+            let (e1, e2) = (sub(rest[b], rest[a]), sub(rest[c], rest[a]));
+            let (f1, f2) = (sub(result[b], result[a]), sub(result[c], result[a]));
+            // The rest triangle in an orthonormal frame of its plane: R = [[x1, x2], [0, y2]].
+            let x1 = norm(e1);
+            let twice_area = norm(cross(e1, e2));
+            if !(x1 > 0.0 && twice_area > 0.0) {
+                return None;
+            }
+            let x2 = dot(e1, e2) / x1;
+            let y2 = twice_area / x1;
+            // J = F R⁻¹ with R⁻¹ = [[1/x1, -x2/(x1 y2)], [0, 1/y2]]; its columns:
+            let j1 = f1.map(|v| v / x1);
+            let j2: [f64; 3] = std::array::from_fn(|k| (f2[k] - f1[k] * x2 / x1) / y2);
+            // Singular values from JᵀJ = [[p, q], [q, r]].
+            let (p, q, r) = (dot(j1, j1), dot(j1, j2), dot(j2, j2));
+            let half_trace = 0.5 * (p + r);
+            let root = (0.25 * (p - r) * (p - r) + q * q).sqrt();
+            let largest = (half_trace + root).sqrt();
+            // σ_min from the determinant, which keeps its digits where σ_min ≪ σ_max.
+            let smallest = if largest > 0.0 { norm(cross(j1, j2)) / largest } else { 0.0 };
+            Some([largest, smallest])
+        })
+        .collect()
+}
+
+/// Isometric distortion of `e.result`: `sqrt( Σ_f A⁰_f (ln² σ_max + ln² σ_min) / 2 / Σ_f A⁰_f )`,
+/// the rest-area-weighted RMS over faces of the logs of each face's stretches
+/// ([`face_stretches`]). 0 exactly for a rigid motion, `|ln s|` for a uniform scaling by `s`; it
+/// sees a change of size (which `E_θ` and `E_φ` do not) and a change of shape (which the total
+/// area does not). A collapsed face gives infinity.
+///
+/// Decision (issue 62): weighted by rest area, not a plain mean over faces, so the answer does not
+/// depend on how finely a region is meshed: real scans mix slivers and large faces.
+pub fn isometric_distortion(e: &Evaluation) -> f64 {
+    let stretches = face_stretches(e.mesh.positions(), e.result, e.mesh.triangles());
+    let (mut sum, mut weight) = (0.0, 0.0);
+    for (s, a0) in stretches.iter().zip(&e.rest.areas) {
+        if let Some([large, small]) = s {
+            let (l1, l2) = (large.ln(), if *small > 0.0 { small.ln() } else { f64::NEG_INFINITY });
+            sum += a0 * 0.5 * (l1 * l1 + l2 * l2);
+            weight += a0;
+        }
+    }
+    if weight > 0.0 {
+        (sum / weight).sqrt()
+    } else {
+        0.0
+    }
+}
+
+/// How far beyond what is asked a face's area may change before it counts as shrunk or swollen in
+/// [`resized_shares`], as a factor: 1.2 is every length about 10% shorter or longer than asked,
+/// which a figure shows. Sound results change the area of a face by less, except where the
+/// reference's own result does so too (the inside of a sharp bend), which the range takes in.
+pub const LOCAL_AREA_MARGIN: f64 = 1.2;
+
+/// `(shrunk, swollen)`: the shares of the rest surface area on faces whose area factor
+/// (`A_f / A⁰_f`) lies beyond the range the handles ask ([`asked_size`]), widened by the same
+/// face's factor in the reference result if there is one, by more than [`LOCAL_AREA_MARGIN`] below
+/// or above. A patch shrunk or swollen on its own is seen even when the total area is not.
+pub fn resized_shares(e: &Evaluation) -> (f64, f64) {
+    let rest = e.mesh.positions();
+    let triangles = e.mesh.triangles();
+    let asked = asked_size(rest, e.handles, e.targets);
+    let ours = face_stretches(rest, e.result, triangles);
+    // A reference that is this very result (the reference judged itself) widens nothing.
+    let theirs = e.reference.filter(|r| *r != e.result).map(|r| face_stretches(rest, r, triangles));
+    let margin = LOCAL_AREA_MARGIN.ln();
+    let (mut shrunk, mut swollen, mut total) = (0.0, 0.0, 0.0);
+    for (f, (s, a0)) in ours.iter().zip(&e.rest.areas).enumerate() {
+        let Some([large, small]) = s else { continue };
+        let reference = theirs.as_ref().and_then(|t| t[f]).map(|[l, s]| l * s);
+        let beyond = asked.with(reference).beyond(large * small);
+        total += a0;
+        if beyond < -margin {
+            shrunk += a0;
+        } else if beyond > margin {
+            swollen += a0;
+        }
+    }
+    if total > 0.0 {
+        (shrunk / total, swollen / total)
+    } else {
+        (0.0, 0.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use methods::HandleRegion;
+
+    fn triangle() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        (vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.5, 1.5, 0.0]], vec![[0, 1, 2]])
+    }
+
+    #[test]
+    fn a_face_stretches_by_the_singular_values_of_its_gradient() {
+        let (rest, faces) = triangle();
+        // A rotation about z by 0.7 and a translation: both 1.
+        let (c, s) = (0.7f64.cos(), 0.7f64.sin());
+        let turned: Vec<[f64; 3]> = rest.iter().map(|p| [c * p[0] - s * p[1] + 3.0, s * p[0] + c * p[1], 1.0]).collect();
+        let [l, m] = face_stretches(&rest, &turned, &faces)[0].unwrap();
+        assert!((l - 1.0).abs() < 1e-12 && (m - 1.0).abs() < 1e-12, "{l} {m}");
+        // x scaled by 3, y by 0.5 (the rest plane): 3 and 0.5.
+        let squeezed: Vec<[f64; 3]> = rest.iter().map(|p| [3.0 * p[0], 0.5 * p[1], 0.0]).collect();
+        let [l, m] = face_stretches(&rest, &squeezed, &faces)[0].unwrap();
+        assert!((l - 3.0).abs() < 1e-12 && (m - 0.5).abs() < 1e-12, "{l} {m}");
+        // A collapsed result: σ_min 0; a collapsed rest face: none.
+        let flat: Vec<[f64; 3]> = rest.iter().map(|p| [p[0], 0.0, 0.0]).collect();
+        assert_eq!(face_stretches(&rest, &flat, &faces)[0].unwrap()[1], 0.0);
+        assert_eq!(face_stretches(&flat, &rest, &faces)[0], None);
+    }
+
+    fn handles(regions: &[&[u32]], n: usize) -> HandleSet {
+        let regions = regions
+            .iter()
+            .enumerate()
+            .map(|(i, v)| HandleRegion { name: format!("r{i}"), vertices: v.to_vec() })
+            .collect();
+        HandleSet::new(regions, n).unwrap()
+    }
+
+    #[test]
+    fn the_handles_ask_a_size_per_region() {
+        // Two regions of three points each, 10 apart along x.
+        let rest: Vec<[f64; 3]> = vec![
+            [0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [10.0, 0.0, 0.0],
+            [10.0, 1.0, 0.0],
+            [10.0, 0.0, 1.0],
+        ];
+        let set = handles(&[&[0, 1, 2], &[3, 4, 5]], rest.len());
+        let asked = |moved: &dyn Fn(usize, [f64; 3]) -> [f64; 3]| {
+            let t = HandleTargets::new(&set, (0..6).map(|v| moved(v, rest[v])).collect()).unwrap();
+            asked_size(&rest, &set, &t)
+        };
+        // The second region turned half a turn about y and brought to x = 4 (a bend): nothing asked.
+        let bent = asked(&|v, p| if v < 3 { p } else { [4.0 - (p[0] - 10.0), p[1], -p[2]] });
+        assert!((bent.low - 1.0).abs() < 1e-12 && (bent.high - 1.0).abs() < 1e-12, "{bent:?}");
+        // Pulled apart to 15: up to 1.5².
+        let pulled = asked(&|v, p| if v < 3 { p } else { [p[0] + 5.0, p[1], p[2]] });
+        assert!((pulled.low - 1.0).abs() < 1e-12 && (pulled.high - 2.25).abs() < 1e-12, "{pulled:?}");
+        // The second region scaled by 0.5 about its centroid: down to 0.25.
+        let scaled = asked(&|v, p| {
+            if v < 3 {
+                p
+            } else {
+                let c = [10.0, 1.0 / 3.0, 1.0 / 3.0];
+                std::array::from_fn(|k| c[k] + 0.5 * (p[k] - c[k]))
+            }
+        });
+        assert!((scaled.low - 0.25).abs() < 1e-12 && (scaled.high - 1.0).abs() < 1e-12, "{scaled:?}");
+        // The range's distance in ln, and a reference's factor taken in.
+        let none = AskedSize::NONE;
+        assert_eq!(none.beyond(1.0), 0.0);
+        assert!((none.beyond(0.5) - 0.5f64.ln()).abs() < 1e-15);
+        assert_eq!(none.beyond(0.0), f64::NEG_INFINITY);
+        assert_eq!(none.with(Some(0.5)).beyond(0.5), 0.0);
+        assert_eq!(none.with(Some(f64::NAN)), none);
+    }
+}
