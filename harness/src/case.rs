@@ -5,7 +5,6 @@ use std::ops::ControlFlow;
 use std::time::Instant;
 
 use crate::config::{ConfiguredMethod, Origin};
-pub use crate::verdict::Reference;
 use crate::metrics::{angle_errors, largest_displacement, Quality, RestGeometry};
 use crate::record::{
     records_quality, CaseResult, IterationRecord, MeasurementTime, ReusedSolveRecord, Spread, StepRecord,
@@ -13,6 +12,7 @@ use crate::record::{
 };
 use crate::scenario::{LoadedScenario, LoadedStep};
 use crate::step_trend::StepTrend;
+pub use crate::verdict::Reference;
 use crate::verdict::{Status, Unfinished, VerdictRules};
 use methods::drive::{drive, Drive, DrivenStep, EditStep};
 use methods::{HandleSet, HandleTargets, IterationObserver, IterationReport, NoObserver, Stopping};
@@ -224,8 +224,12 @@ fn judge(
     reference: Reference<'_>,
 ) -> Judged {
     let start = Instant::now();
-    let steps: Vec<(&HandleSet, &HandleTargets)> =
-        scenario.steps.iter().zip(&drive.steps).map(|(step, driven)| (&step.handles, &driven.targets)).collect();
+    let steps: Vec<(&HandleSet, &HandleTargets)> = scenario
+        .steps
+        .iter()
+        .zip(&drive.steps)
+        .map(|(step, driven)| (&step.handles, &driven.targets))
+        .collect();
     let measures::Judgement { quality, motion, mut reasons } = measures::judge_on(
         rules,
         rest,

@@ -12,8 +12,8 @@ use crate::record::CaseResult;
 /// The time budgets per edit of the budget table, in seconds.
 pub const BUDGETS_S: [f64; 5] = [1e-3, 1e-2, 1e-1, 1.0, 10.0];
 
-/// The quality measures drawn against time (E_theta first: the default).
-pub const MEASURES: [Metric; 3] = [Metric::ETheta, Metric::EPhi, Metric::EArea];
+/// The quality measures drawn against time (e_iso first: the page's default ranking measure).
+pub const MEASURES: [Metric; 4] = [Metric::EIso, Metric::ETheta, Metric::EPhi, Metric::EArea];
 
 /// Which time a point is placed at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

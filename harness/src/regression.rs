@@ -333,7 +333,7 @@ mod tests {
         let json = serde_json::json!({
             "scenario": scenario, "method": method, "mesh_source": "survey", "vertices": 10, "faces": 16,
             "precompute_s": 0.0, "bind_s": 0.0, "median_iteration_ms": 0.0, "iterations": 1, "solve_s": 0.0,
-            "total_s": 0.0, "converged": true, "e_theta_deg": e_theta, "e_phi_deg": e_phi,
+            "total_s": 0.0, "converged": true, "e_iso": 0.08, "e_theta_deg": e_theta, "e_phi_deg": e_phi,
             "e_area": 0.1, "e_length": 0.05, "area_change": 0.03, "volume_change": -0.2, "folds": 0.0,
             "handle_residual_over_diag": 0.0, "rms_to_arap_over_diag": null, "status": status,
             "phase_timings": [], "statistics": [], "steps": [], "trace": []

@@ -242,7 +242,7 @@ pub const METRICS: [MetricSpec; 17] = [
         key: "shrunk_share",
         label: "shrunk",
         unit: "",
-        doc: "share of the rest surface area on faces whose area fell more than a factor 1.2 below what \
+        doc: "share of the rest surface area on faces whose area fell more than a factor 1.5 below what \
               the handles ask (per region from its own motion; a bend asks none) and below the same face \
               in the arap result",
         better: Better::Lower,
@@ -256,7 +256,7 @@ pub const METRICS: [MetricSpec; 17] = [
         key: "swollen_share",
         label: "swollen",
         unit: "",
-        doc: "share of the rest surface area on faces whose area grew more than a factor 1.2 beyond what \
+        doc: "share of the rest surface area on faces whose area grew more than a factor 1.5 beyond what \
               the handles ask and beyond the same face in the arap result",
         better: Better::Lower,
         gate: None,

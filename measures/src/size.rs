@@ -87,7 +87,8 @@ pub fn asked_size(rest: &[[f64; 3]], handles: &HandleSet, targets: &HandleTarget
                 let (c0, c1) = centroids(&pairs);
                 let spread0: f64 = pairs.iter().map(|(p, _)| norm(sub(*p, c0)).powi(2)).sum();
                 let spread1: f64 = pairs.iter().map(|(_, t)| norm(sub(*t, c1)).powi(2)).sum();
-                let scale = if spread0 > 0.0 && spread1.is_finite() { (spread1 / spread0).sqrt() } else { 1.0 };
+                let scale =
+                    if spread0 > 0.0 && spread1.is_finite() { (spread1 / spread0).sqrt() } else { 1.0 };
                 (c0, c1, scale)
             })
         })
@@ -185,10 +186,13 @@ pub fn isometric_distortion(e: &Evaluation) -> f64 {
 }
 
 /// How far beyond what is asked a face's area may change before it counts as shrunk or swollen in
-/// [`resized_shares`], as a factor: 1.2 is every length about 10% shorter or longer than asked,
-/// which a figure shows. Sound results change the area of a face by less, except where the
-/// reference's own result does so too (the inside of a sharp bend), which the range takes in.
-pub const LOCAL_AREA_MARGIN: f64 = 1.2;
+/// [`resized_shares`], as a factor: 1.5 is every length about 22% shorter or longer than asked.
+/// Measured on the survey tests (issue 62), beside arap's result face by face: the sound results
+/// of isolines and hirm on the cactus have 13-15% of their surface beyond a factor 1.2 of arap's
+/// (a Laplacian method's bend is a little thinner: pale in the area heat map) and at most 0.5%
+/// beyond 1.5; the cylinder's visibly pinched (hirm) and thinned (scale_aware_ora) results have
+/// 17-18% beyond 1.5.
+pub const LOCAL_AREA_MARGIN: f64 = 1.5;
 
 /// `(shrunk, swollen)`: the shares of the rest surface area on faces whose area factor
 /// (`A_f / A⁰_f`) lies beyond the range the handles ask ([`asked_size`]), widened by the same
@@ -235,7 +239,8 @@ mod tests {
         let (rest, faces) = triangle();
         // A rotation about z by 0.7 and a translation: both 1.
         let (c, s) = (0.7f64.cos(), 0.7f64.sin());
-        let turned: Vec<[f64; 3]> = rest.iter().map(|p| [c * p[0] - s * p[1] + 3.0, s * p[0] + c * p[1], 1.0]).collect();
+        let turned: Vec<[f64; 3]> =
+            rest.iter().map(|p| [c * p[0] - s * p[1] + 3.0, s * p[0] + c * p[1], 1.0]).collect();
         let [l, m] = face_stretches(&rest, &turned, &faces)[0].unwrap();
         assert!((l - 1.0).abs() < 1e-12 && (m - 1.0).abs() < 1e-12, "{l} {m}");
         // x scaled by 3, y by 0.5 (the rest plane): 3 and 0.5.

@@ -129,7 +129,9 @@ impl Motion {
         let (handles, targets) = *steps.last().expect("an edit has at least one step");
         let (reference_size, reference_finished) = match reference {
             Reference::Itself => (None, true),
-            Reference::Of { positions, finished } => (finished.then(|| size_factors(rest_geometry, mesh, positions)), finished),
+            Reference::Of { positions, finished } => {
+                (finished.then(|| size_factors(rest_geometry, mesh, positions)), finished)
+            }
             Reference::Missing => (None, false),
         };
         Motion {
@@ -243,14 +245,17 @@ impl VerdictRules {
             Some((area, volume)) => (Some(area), volume),
             None => (None, None),
         };
+        let asked = motion.asked_size;
         let measured = [
-            ("surface area", Metric::AreaChange, motion.asked_size.with(reference_area), reference_area, margin),
-            ("volume", Metric::VolumeChange, motion.asked_size.volume().with(reference_volume), reference_volume, 1.5 * margin),
+            ("surface area", Metric::AreaChange, asked, reference_area, margin),
+            ("volume", Metric::VolumeChange, asked.volume(), reference_volume, 1.5 * margin),
         ];
         let mut totals: Vec<(&str, String)> = Vec::new();
-        for (what, metric, range, beside, margin) in measured {
-            let Some(factor) = quality.get(metric).filter(|c| c.is_finite()).map(|c| 1.0 + c) else { continue };
-            let beyond = range.beyond(factor);
+        for (what, metric, asked, beside, margin) in measured {
+            let Some(factor) = quality.get(metric).filter(|c| c.is_finite()).map(|c| 1.0 + c) else {
+                continue;
+            };
+            let beyond = asked.with(beside).beyond(factor);
             let kind = if beyond < -margin {
                 "shrinks"
             } else if beyond > margin {
@@ -258,18 +263,24 @@ impl VerdictRules {
             } else {
                 continue;
             };
-            let asked = if range.low == 1.0 && range.high == 1.0 && beside.is_none() {
-                "no change".to_string()
+            let asked = if asked == AskedSize::NONE {
+                "the handles ask no change".to_string()
             } else {
-                format!("{:+.0}% to {:+.0}%", 100.0 * (range.low - 1.0), 100.0 * (range.high - 1.0))
+                let percent = |f: f64| format!("{:+.0}%", 100.0 * (f - 1.0));
+                format!("the handles ask {} to {}", percent(asked.low), percent(asked.high))
             };
-            let beside = beside.map_or(String::new(), |r| format!(", arap's {:+.1}% among them", 100.0 * (r - 1.0)));
+            let beside =
+                beside.map_or(String::new(), |r| format!(" and arap's changed {:+.1}%", 100.0 * (r - 1.0)));
             let went = if kind == "shrinks" { "fell" } else { "grew" };
-            totals.push((kind, format!("its {what} {went} {:+.0}% where {asked} is asked{beside}", 100.0 * (factor - 1.0))));
+            totals.push((
+                kind,
+                format!("its {what} {went} {:+.0}% where {asked}{beside}", 100.0 * (factor - 1.0)),
+            ));
         }
         let mut reasons = Vec::new();
         for kind in ["shrinks", "swells"] {
-            let parts: Vec<&str> = totals.iter().filter(|(k, _)| *k == kind).map(|(_, t)| t.as_str()).collect();
+            let parts: Vec<&str> =
+                totals.iter().filter(|(k, _)| *k == kind).map(|(_, t)| t.as_str()).collect();
             if !parts.is_empty() {
                 reasons.push(format!(
                     "{kind}: {} (> {:.0}% beyond)",
@@ -278,7 +289,11 @@ impl VerdictRules {
                 ));
                 continue;
             }
-            let (metric, went) = if kind == "shrinks" { (Metric::ShrunkShare, "lost") } else { (Metric::SwollenShare, "gained") };
+            let (metric, went) = if kind == "shrinks" {
+                (Metric::ShrunkShare, "lost")
+            } else {
+                (Metric::SwollenShare, "gained")
+            };
             if let Some(share) = quality.get(metric).filter(|s| *s > self.max_resized_share) {
                 reasons.push(format!(
                     "{kind} in places: {:.1}% of its surface {went} more than a factor {:.1} of area beyond what \
@@ -417,6 +432,59 @@ mod tests {
                 "swells",
                 "leaves its frame"
             ]
+        );
+    }
+
+    #[test]
+    fn size_is_judged_per_region_beside_the_reference_and_in_places() {
+        let r = rules();
+        // A bend asks nothing: -27% of area shrinks, even where the spread of the targets fell.
+        let mut q = quality(0.0, 0.0);
+        q.set(Metric::AreaChange, Some(-0.27));
+        let reasons = r.reasons(&q, moved(0.3));
+        assert!(
+            reasons.len() == 1
+                && reasons[0]
+                    .starts_with("shrinks: its surface area fell -27% where the handles ask no change ("),
+            "{reasons:?}"
+        );
+        // Beside a reference that lost 20% itself, -27% is inside 0.8 / 1.25.
+        let beside = Motion { reference_size: Some((0.8, None)), ..moved(0.3) };
+        assert!(r.reasons(&q, beside).is_empty());
+        // A closed mesh's volume, with the same margin on lengths: 1.25^1.5 = 1.40.
+        let mut v = quality(0.0, 0.0);
+        v.set(Metric::VolumeChange, Some(-0.27));
+        assert!(r.reasons(&v, moved(0.3)).is_empty(), "0.73 > 1 / 1.40");
+        v.set(Metric::VolumeChange, Some(-0.31));
+        let reasons = r.reasons(&v, moved(0.3));
+        assert!(reasons.len() == 1 && reasons[0].starts_with("shrinks: its volume fell -31%"), "{reasons:?}");
+        // Area and volume both: one reason of the kind naming both.
+        v.set(Metric::AreaChange, Some(-0.3));
+        let reasons = r.reasons(&v, moved(0.3));
+        assert!(
+            reasons.len() == 1 && reasons[0].contains("surface area") && reasons[0].contains("volume"),
+            "{reasons:?}"
+        );
+        // In places: a share above 5% of the surface resized, when the totals pass.
+        let mut local = quality(0.0, 0.0);
+        local.set(Metric::ShrunkShare, Some(0.05));
+        local.set(Metric::SwollenShare, Some(0.051));
+        let reasons = r.reasons(&local, moved(0.3));
+        assert!(
+            reasons.len() == 1 && reasons[0].starts_with("swells in places: 5.1% of its surface"),
+            "{reasons:?}"
+        );
+        assert_eq!(reason_kind(&reasons[0]), Some("swells"));
+        // Turned in places: above 2% of the free surface, when the 90th percentile passes.
+        let mut turned = quality(0.0, 0.0);
+        turned.set(Metric::TurnBeyondHandles, Some(10.0));
+        turned.set(Metric::TurnedShare, Some(0.02));
+        assert!(r.reasons(&turned, moved(0.3)).is_empty());
+        turned.set(Metric::TurnedShare, Some(0.03));
+        let reasons = r.reasons(&turned, moved(0.3));
+        assert!(
+            reasons.len() == 1 && reasons[0].starts_with("turns a free region: 3.0% of its free surface"),
+            "{reasons:?}"
         );
     }
 

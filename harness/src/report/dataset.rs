@@ -2,12 +2,12 @@
 //! [`Member`]: an edit family run over many meshes), `dataset.md` and the page's section with
 //! - robustness: per family and method, how many cases were ok / suspect / unfinished / failed,
 //!   and how many meshes were skipped before any method ran;
-//! - error spread: per family and method, the median and 90th percentile of E_theta, E_phi, e_area
-//!   and the RMS distance to arap, over the cases with a finished shape (ok or suspect);
+//! - error spread: per family and method, the median and 90th percentile of e_iso, E_theta, E_phi,
+//!   e_area and the RMS distance to arap, over the cases with a finished shape (ok or suspect);
 //! - cost: the median time per edit (bind + solve) and with the precompute, and the fitted slope
 //!   of log time against log #V ([`cost_slope`]), the cost growth the papers claim;
-//! - rank: each method's median rank by E_phi among the methods run on the same mesh and edit
-//!   ([`ranks`]).
+//! - rank: each method's median rank by e_iso among the `ok` cases on the same mesh and edit
+//!   ([`ranks`]); the cases not ranked are counted under each table with their reasons.
 //! The plots (ECDFs, cost against #V) are in [`super::plots`], the worst-case sheets in
 //! [`super::render`].
 
@@ -21,13 +21,16 @@ use crate::scenario::SkippedInput;
 use crate::verdict::{reason_kind, REASON_KINDS, STATUS_KINDS};
 
 /// The measures whose spread the report gives, lower is better for each.
-pub const SPREAD_MEASURES: [Metric; 4] = [Metric::ETheta, Metric::EPhi, Metric::EArea, Metric::RmsToArap];
+pub const SPREAD_MEASURES: [Metric; 5] =
+    [Metric::EIso, Metric::ETheta, Metric::EPhi, Metric::EArea, Metric::RmsToArap];
 
 /// How many of a method's worst `ok` cases per family a worst-case sheet shows.
 pub const WORST_PER_METHOD: usize = 5;
 
-/// The measure worst-case sheets and ranks order by.
-pub const RANK_MEASURE: Metric = Metric::EPhi;
+/// The measure worst-case sheets and ranks order by: e_iso, which sees size and angle together
+/// (issue 62: by E_phi, blind to size, scale_aware ranked first on bend and stretch with the largest
+/// e_area of any method there).
+pub const RANK_MEASURE: Metric = Metric::EIso;
 
 /// The cases of `results` that belong to a collection, if any.
 pub fn dataset_cases(results: &[CaseResult]) -> Vec<&CaseResult> {
@@ -92,25 +95,61 @@ pub fn cost_slope(points: impl Iterator<Item = (usize, f64)>) -> (f64, usize) {
     (if sxx > 0.0 { sxy / sxx } else { f64::NAN }, n)
 }
 
-/// Each case's rank by [`RANK_MEASURE`] among the cases of its scenario (1 = best): cases with a
-/// finished shape in order of the measure (ties share the better rank), then every unfinished or
-/// failed case at the last rank (the number of cases of the scenario). Keyed by (scenario, method).
+/// Each `ok` case's rank by [`RANK_MEASURE`] among the `ok` cases of its scenario (1 = best; ties
+/// share the better rank), keyed by (scenario, method). Suspect, unfinished and failed cases have
+/// no rank (issue 62: a broken result ranked among clean ones misleads; [`unranked`] lists them).
 pub fn ranks(cases: &[&CaseResult]) -> BTreeMap<(String, String), usize> {
     let mut by_scenario: BTreeMap<&str, Vec<&CaseResult>> = BTreeMap::new();
-    for c in cases {
+    for c in cases.iter().filter(|c| c.status.is_ok() && c.metric(RANK_MEASURE).is_finite()) {
         by_scenario.entry(&c.scenario).or_default().push(c);
     }
     let mut out = BTreeMap::new();
     for (scenario, group) in by_scenario {
-        let value = |c: &CaseResult| if finished(c) { c.metric(RANK_MEASURE) } else { f64::NAN };
         for c in &group {
-            let v = value(c);
-            let rank =
-                if v.is_finite() { 1 + group.iter().filter(|o| value(o) < v).count() } else { group.len() };
+            let v = c.metric(RANK_MEASURE);
+            let rank = 1 + group.iter().filter(|o| o.metric(RANK_MEASURE) < v).count();
             out.insert((scenario.to_string(), c.method.clone()), rank);
         }
     }
     out
+}
+
+/// Per method of `methods`, how many of its cases in `family` (all: `None`) have no rank, and why:
+/// `scale_aware 7 (suspect 6: swells 4, shrinks 2; unfinished 1)`; `None` when every case is ranked.
+pub fn unranked(cases: &[&CaseResult], methods: &[&str], family: Option<&str>) -> Option<String> {
+    let ranks = ranks(cases);
+    let mut parts = Vec::new();
+    for m in methods {
+        let left: Vec<&CaseResult> = (cases.iter().copied())
+            .filter(|c| c.method == *m && family.is_none_or(|f| family_of(c) == f))
+            .filter(|c| !ranks.contains_key(&(c.scenario.clone(), c.method.clone())))
+            .collect();
+        if left.is_empty() {
+            continue;
+        }
+        let mut why = Vec::new();
+        for kind in STATUS_KINDS {
+            let of: Vec<&CaseResult> = left.iter().copied().filter(|c| c.status.kind() == kind).collect();
+            if of.is_empty() {
+                continue;
+            }
+            let reasons: Vec<String> = REASON_KINDS
+                .iter()
+                .filter_map(|r| {
+                    let n = of
+                        .iter()
+                        .filter(|c| c.status.shape_reasons().any(|t| reason_kind(t) == Some(r)))
+                        .count();
+                    (n > 0 && kind == STATUS_KINDS[1]).then(|| format!("{r} {n}"))
+                })
+                .collect();
+            let reasons =
+                if reasons.is_empty() { String::new() } else { format!(": {}", reasons.join(", ")) };
+            why.push(format!("{kind} {}{reasons}", of.len()));
+        }
+        parts.push(format!("{m} {} ({})", left.len(), why.join("; ")));
+    }
+    (!parts.is_empty()).then(|| format!("Not ranked: {}.", parts.join("; ")))
 }
 
 /// For each family, each method's [`WORST_PER_METHOD`] `ok` cases with the largest
@@ -254,13 +293,17 @@ fn error_spread_cost_and_rank(document: &mut Document, cases: &[&CaseResult], me
     document.heading(2, "Error spread, cost and rank");
     document.paragraph(
         "Median and 90th percentile over the cases with a finished shape (ok or suspect); times are medians \
-         over the cases that ran (failed ones have none); rank by E_phi among the methods on the same mesh and \
-         edit (1 = best; unfinished and failed cases take the last rank).",
+         over the cases that ran (failed ones have none); rank by e_iso (size and angle together) among the \
+         ok cases on the same mesh and edit (1 = best); the median rank counts ranked cases only, and the \
+         cases not ranked (suspect, unfinished, failed) are counted under each table with their reasons.",
     );
     let ranks = ranks(cases);
     for family in families(cases).into_iter().map(Some).chain([None]) {
         document.heading(3, family.unwrap_or("all families"));
         document.table(spread_table(cases, methods, family, &ranks));
+        if let Some(note) = unranked(cases, methods, family) {
+            document.paragraph(note);
+        }
     }
 }
 
@@ -274,8 +317,9 @@ fn spread_table(
 ) -> Table {
     let spreads = SPREAD_MEASURES.iter().map(|m| format!("{} median / p90", m.spec().label));
     let titles = ["method", "finished"].map(String::from).into_iter().chain(spreads);
-    let mut table =
-        Table::new(titles.chain(["time per edit", "with precompute", "median rank"].map(String::from)));
+    let mut table = Table::new(
+        titles.chain(["time per edit", "with precompute", "ranked", "median rank"].map(String::from)),
+    );
     for m in methods {
         let of: Vec<&CaseResult> = cases
             .iter()
@@ -291,9 +335,14 @@ fn spread_table(
         let ran = || of.iter().filter(|c| !c.status.is_failed());
         let (edit, _) = median_and_p90(ran().map(|c| TimeAxis::Edit.seconds(c)));
         let (with, _) = median_and_p90(ran().map(|c| TimeAxis::WithPrecompute.seconds(c)));
-        let rank = of.iter().filter_map(|c| ranks.get(&(c.scenario.clone(), c.method.clone())));
-        let (rank, _) = median_and_p90(rank.map(|&r| r as f64));
-        cells.extend([time(edit), time(with), num(rank)]);
+        let rank: Vec<f64> = of
+            .iter()
+            .filter_map(|c| ranks.get(&(c.scenario.clone(), c.method.clone())))
+            .map(|&r| r as f64)
+            .collect();
+        let ranked = format!("{} of {}", rank.len(), of.len());
+        let (rank, _) = median_and_p90(rank.into_iter());
+        cells.extend([time(edit), time(with), ranked, num(rank)]);
         table.push_row(cells);
     }
     table
@@ -400,6 +449,7 @@ mod tests {
             repaired: None,
         });
         c.quality.set(Metric::EPhi, e_phi.is_finite().then_some(e_phi));
+        c.quality.set(RANK_MEASURE, e_phi.is_finite().then_some(e_phi));
         c.status = status;
         c
     }
@@ -414,7 +464,7 @@ mod tests {
     }
 
     #[test]
-    fn ranks_put_unfinished_and_failed_cases_last_and_ties_share() {
+    fn only_ok_cases_are_ranked_ties_share_and_the_others_are_listed_with_their_reasons() {
         let cases = [
             case("bend", "a", "arap", 10, 1.0, Status::Ok),
             case("bend", "a", "hirm", 10, 3.0, Status::Suspect(vec!["folds".into()])),
@@ -424,15 +474,21 @@ mod tests {
         ];
         let refs: Vec<&CaseResult> = cases.iter().collect();
         let r = ranks(&refs);
-        let rank = |m: &str| r[&("bend-a".to_string(), m.to_string())];
+        let rank = |m: &str| r.get(&("bend-a".to_string(), m.to_string())).copied();
         assert_eq!(
             [rank("arap"), rank("laplacian"), rank("hirm"), rank("isolines"), rank("spectral_mhb")],
-            [1, 1, 3, 5, 5]
+            [Some(1), Some(1), None, None, None]
         );
+        let methods = methods_of(&refs);
+        assert_eq!(
+            unranked(&refs, &methods, None).unwrap(),
+            "Not ranked: hirm 1 (suspect 1: folds 1); isolines 1 (unfinished 1); spectral_mhb 1 (failed 1)."
+        );
+        assert_eq!(unranked(&refs[..2], &methods, Some("twist")), None);
     }
 
     #[test]
-    fn worst_sheets_take_the_largest_e_phi_of_ok_cases_only() {
+    fn worst_sheets_take_the_largest_rank_measure_of_ok_cases_only() {
         let mut cases: Vec<CaseResult> =
             (0..8).map(|i| case("twist", &format!("m{i}"), "hirm", 100, i as f64, Status::Ok)).collect();
         cases.push(case("twist", "bad", "hirm", 100, 90.0, Status::Suspect(vec!["folds".into()])));

@@ -151,6 +151,7 @@ fn head(page: &mut String, context: &PageContext) {
         "div.ranking-grid{display:flex;flex-wrap:wrap;gap:1em;align-items:flex-start}table.ranking{margin:0}\n",
         "table.ranking caption,#median-ranks caption{font-weight:bold;text-align:left}\n",
         "table.ranking tr.ok td{background:#e6f5e6}\n",
+        "ul.unranked{list-style:none;padding:0;margin:.3em 0;max-width:22em;font-size:90%}ul.unranked li.suspect{background:#fff4d6}\n",
         "</style>\n</head>\n<body>\n",
         "<h1>deformbench: handle-based mesh deformation, side by side</h1>\n"
     ));
@@ -263,12 +264,13 @@ fn result_row(page: &mut String, r: &CaseResult, viewable: &[String]) {
     let (class, badge) = origin_mark(r);
     let _ = write!(
         page,
-        "<tr class=\"{class}\" data-scenario=\"{}\" data-method=\"{}\" data-status=\"{}\" data-source=\"{}\"{}{}>\
+        "<tr class=\"{class}\" data-scenario=\"{}\" data-method=\"{}\" data-status=\"{}\" data-why=\"{}\" data-source=\"{}\"{}{}>\
          <td class=\"text\">{}</td><td class=\"text\">{}{badge}</td><td class=\"text status\">{}</td>\
          <td data-v=\"{}\">{}</td><td data-v=\"{}\">{}</td><td>{}</td>",
         escape(&r.scenario),
         escape(&r.method),
         r.status.kind(),
+        escape(&reason_kinds(&r.status)),
         escape(&r.mesh_source),
         member_attributes(r),
         view_attributes(r, viewable),
@@ -294,6 +296,18 @@ fn result_row(page: &mut String, r: &CaseResult, viewable: &[String]) {
         "<td>{}</td></tr>",
         r.self_intersecting.map_or("not checked", |b| if b { "yes" } else { "no" }),
     );
+}
+
+/// The kinds of a status's shape reasons, each once, in order (`folds, shrinks`): the short form
+/// the ranking's "not ranked" lists show (the full text is the row's status cell).
+fn reason_kinds(status: &crate::verdict::Status) -> String {
+    let mut kinds: Vec<&str> = Vec::new();
+    for kind in status.shape_reasons().filter_map(|r| crate::verdict::reason_kind(r)) {
+        if !kinds.contains(&kind) {
+            kinds.push(kind);
+        }
+    }
+    kinds.join(", ")
 }
 
 /// A row's class (its status, and its origin when not built in) and the mark beside its method: a
@@ -678,10 +692,14 @@ fn better_word(better: crate::metrics::Better) -> &'static str {
 /// from the results table (`page.js`).
 fn answer_first(page: &mut String, _: &PageContext) {
     page.push_str(
-        "<h2 id=\"answer\">Which method</h2>\n<p>Rank by <select id=\"rank-by\"></select>: per test, the \
-         finished cases from best to worst (colour: the verdict; suspect ones count, marked), with the time \
-         per edit (bind + solve); then each method's median rank over the tests it ran on. Sort and filter \
-         the full table below, and click a row to turn its result in 3D; the address keeps the choice (<code>?rank=e_phi_deg&amp;sort=total_s&amp;status=ok</code>).</p>\n\
+        "<h2 id=\"answer\">Which method</h2>\n<p>Rank by <select id=\"rank-by\"></select> \
+         <label><input type=\"checkbox\" id=\"rank-suspect\"> rank suspect results too</label>: per test, \
+         the <code>ok</code> results from best to worst, with the time per edit (bind + solve); under each \
+         table the results not ranked (suspect, unfinished, failed) with their reasons; then each method's \
+         median rank over the tests where it was ranked. The default measure, e_iso, sees size and angle \
+         together (a swollen or shrunk result ranks low by it, where E_θ and E_φ do not see size). Sort \
+         and filter the full table below, and click a row to turn its result in 3D; the address keeps \
+         the choice (<code>?rank=e_phi_deg&amp;suspect=1&amp;sort=total_s&amp;status=ok</code>).</p>\n\
          <div id=\"ranking\"></div>\n",
     );
 }

@@ -98,14 +98,18 @@
   applyFilters();
   if (params.get('sort')) sortBy(params.get('sort'), params.get('desc') === '1');
 
-  // ---- "Which method": rank the finished cases of each test by the chosen measure.
+  // ---- "Which method": rank the `ok` cases of each test by the chosen measure (e_iso unless the
+  // reader picks another); suspect, unfinished and failed cases are listed under each table with
+  // their reasons, and ranked only when the reader asks for the suspect ones too.
   var rankBy = document.getElementById('rank-by');
+  var rankSuspect = document.getElementById('rank-suspect');
+  rankSuspect.checked = params.get('suspect') === '1';
   var ranking = document.getElementById('ranking');
   headers.filter(function (th) { return th.dataset.better; }).forEach(function (th) {
     rankBy.add(new Option(th.textContent, th.dataset.key));
   });
   rankBy.value = column[params.get('rank')] !== undefined && headers[column[params.get('rank')]].dataset.better
-    ? params.get('rank') : 'e_theta_deg';
+    ? params.get('rank') : 'e_iso';
 
   function cell(tag, text, cls) {
     var c = document.createElement(tag);
@@ -127,10 +131,13 @@
     var grid = document.createElement('div');
     grid.className = 'ranking-grid';
     tests.forEach(function (test) {
-      var finished = rows.filter(function (r) {
-        return r.dataset.scenario === test && (r.dataset.status === 'ok' || r.dataset.status === 'suspect') &&
+      var ranked = function (r) {
+        return (r.dataset.status === 'ok' || (rankSuspect.checked && r.dataset.status === 'suspect')) &&
           !isNaN(badness(r));
-      }).sort(function (a, b) { return badness(a) - badness(b); });
+      };
+      var ofTest = rows.filter(function (r) { return r.dataset.scenario === test; });
+      var finished = ofTest.filter(ranked).sort(function (a, b) { return badness(a) - badness(b); });
+      var left = ofTest.filter(function (r) { return !ranked(r); });
       var t = document.createElement('table');
       t.className = 'ranking';
       t.dataset.scenario = test;
@@ -151,10 +158,26 @@
         tr.appendChild(cell('td', seconds(value(r, 'bind_s') + value(r, 'solve_s'))));
         (ranks[r.dataset.method] = ranks[r.dataset.method] || []).push(i + 1);
       });
-      grid.appendChild(t);
+      var box = document.createElement('div');
+      box.appendChild(t);
+      if (left.length) {
+        var list = document.createElement('ul');
+        list.className = 'unranked';
+        list.appendChild(cell('li', 'not ranked:', 'unranked-head'));
+        left.forEach(function (r) {
+          var why = r.dataset.why ? ': ' + r.dataset.why : '';
+          var li = cell('li', r.dataset.method + ' — ' + r.dataset.status + why);
+          li.title = r.querySelector('td.status').textContent;
+          li.className = r.dataset.status;
+          li.dataset.method = r.dataset.method;
+          list.appendChild(li);
+        });
+        box.appendChild(list);
+      }
+      grid.appendChild(box);
     });
     ranking.appendChild(grid);
-    // Across tests: the median rank of each method over the tests it finished.
+    // Across tests: the median rank of each method over the tests it was ranked on.
     var medians = Object.keys(ranks).map(function (m) {
       var r = ranks[m].slice().sort(function (a, b) { return a - b; });
       var mid = Math.floor(r.length / 2);
@@ -162,9 +185,9 @@
     }).sort(function (a, b) { return a[1] - b[1] || a[0].localeCompare(b[0]); });
     var across = document.createElement('table');
     across.id = 'median-ranks';
-    across.appendChild(cell('caption', 'median rank over the tests'));
+    across.appendChild(cell('caption', 'median rank over the tests where it was ranked'));
     var head = across.insertRow();
-    ['method', 'median rank', 'tests'].forEach(function (h) { head.appendChild(cell('th', h)); });
+    ['method', 'median rank', 'tests ranked'].forEach(function (h) { head.appendChild(cell('th', h)); });
     medians.forEach(function (m) {
       var tr = across.insertRow();
       tr.dataset.method = m[0];
@@ -173,9 +196,11 @@
       tr.appendChild(cell('td', String(m[2])));
     });
     ranking.appendChild(across);
-    remember('rank', key === 'e_theta_deg' ? '' : key);
+    remember('rank', key === 'e_iso' ? '' : key);
+    remember('suspect', rankSuspect.checked ? '1' : '');
   }
   rankBy.addEventListener('change', rank);
+  rankSuspect.addEventListener('change', rank);
   rank();
 
   // The first two columns stay in view while the table scrolls sideways.

@@ -32,9 +32,9 @@ const SIZE: (u32, u32) = (960, 540);
 /// Pixel size of the errors plot (one panel per plotted metric, side by side).
 const ERRORS_SIZE: (u32, u32) = (1500, 560);
 /// Pixel size of the dataset's ECDF plot (two by two measures).
-const ECDF_SIZE: (u32, u32) = (1500, 1100);
+const ECDF_SIZE: (u32, u32) = (1500, 1600);
 /// Pixel size of the quality–time plot (three measures by two time axes).
-const PARETO_SIZE: (u32, u32) = (1600, 1500);
+const PARETO_SIZE: (u32, u32) = (1600, 1950);
 /// Three panels side by side, each with a legend of (series, method) lines.
 const SIZE_SERIES_SIZE: (u32, u32) = (1800, 640);
 
@@ -564,7 +564,7 @@ fn draw_dataset_ecdf<DB: DrawingBackend>(root: Area<'_, DB>, cases: &[&CaseResul
         )
         .map_err(err)?;
     let methods = methods_of(cases);
-    for (panel, measure) in root.split_evenly((2, 2)).into_iter().zip(SPREAD_MEASURES) {
+    for (panel, measure) in root.split_evenly((3, 2)).into_iter().zip(SPREAD_MEASURES) {
         let curve = |m: &str| -> Vec<(f64, f64)> {
             let of: Vec<&&CaseResult> = cases.iter().filter(|c| c.method == m).collect();
             let mut values: Vec<f64> = of
