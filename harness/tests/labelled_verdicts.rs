@@ -30,12 +30,20 @@ fn report_and_check(judged: &[Judged], skipped: &[Skipped]) {
     let mut wrong = Vec::new();
     for (name, missed) in &tally.bad_missed {
         let case = judged.iter().find(|c| &c.name == name).unwrap();
-        wrong.push(format!("bad case `{name}` not flagged with {missed:?}: {:?}; {}", case.judgement.reasons, tally::measured(case)));
+        wrong.push(format!(
+            "bad case `{name}` not flagged with {missed:?}: {:?}; {}",
+            case.judgement.reasons,
+            tally::measured(case)
+        ));
     }
     if tally.good_flagged_share() > 0.02 {
         for name in &tally.good_flagged {
             let case = judged.iter().find(|c| &c.name == name).unwrap();
-            wrong.push(format!("good case `{name}` flagged: {:?}; {}", case.judgement.reasons, tally::measured(case)));
+            wrong.push(format!(
+                "good case `{name}` flagged: {:?}; {}",
+                case.judgement.reasons,
+                tally::measured(case)
+            ));
         }
     }
     assert!(wrong.is_empty(), "{} cases judged wrong:\n{}", wrong.len(), wrong.join("\n"));
@@ -56,7 +64,8 @@ fn the_verdicts_find_every_labelled_defect_and_pass_the_sound_results() {
 #[ignore]
 fn the_verdicts_judge_the_suites_own_results_as_a_person_does() {
     let rules = VerdictRules::load(&root().join("configs/verdicts.toml")).unwrap();
-    let set = LabelledSet::load(&root().join("configs/labelled")).unwrap();
+    let dir = std::env::var_os("DEFORM_LABELLED_DIR").map_or(root().join("configs/labelled"), PathBuf::from);
+    let set = LabelledSet::load(&dir).unwrap();
     let catalog = MethodCatalog::load(&root().join("configs/methods.toml")).unwrap();
     let (judged, skipped) = judge_real(&set.real, &catalog, &rules, &dirs()).unwrap();
     report_and_check(&judged, &skipped);

@@ -186,7 +186,7 @@ impl Edit {
         let (factor, degrees) = match *self {
             Edit::Rigid { degrees, .. } => (1.0, degrees),
             Edit::Scale { factor, degrees, .. } => (factor, degrees),
-            Edit::Bend { degrees } if degrees == 0.0 => return Err("bend: `degrees` must not be 0".into()),
+            Edit::Bend { degrees: 0.0 } => return Err("bend: `degrees` must not be 0".into()),
             Edit::Bend { degrees } | Edit::Twist { degrees } => (1.0, degrees),
         };
         if !(factor.is_finite() && factor > 0.0) {
@@ -260,9 +260,16 @@ impl Patch {
             })
             .map_or(s.diagonal, |(d, _)| *d)
             .max(f64::MIN_POSITIVE);
-        let weights = (0..rest.len())
-            .map(|v| if is_free(v) { 1.0 - smoothstep(norm(sub(rest[v], center)) / radius - 1.0) } else { 0.0 })
-            .collect();
+        let weights =
+            (0..rest.len())
+                .map(|v| {
+                    if is_free(v) {
+                        1.0 - smoothstep(norm(sub(rest[v], center)) / radius - 1.0)
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
         let normal = meshes::geometry::vertex_normals(rest, triangles)[seed];
         Patch { center, normal: normalize_or_zero(normal), radius, weights }
     }
@@ -284,7 +291,9 @@ impl Defect {
             Defect::Miss { distance, ref region } => return missed(s, good, distance, region.as_deref()),
             Defect::LeftBehind { share } => {
                 let w = Patch::new(s, share).weights;
-                return (0..rest.len()).map(|v| add(scale(good[v], 1.0 - w[v]), scale(rest[v], w[v]))).collect();
+                return (0..rest.len())
+                    .map(|v| add(scale(good[v], 1.0 - w[v]), scale(rest[v], w[v])))
+                    .collect();
             }
             Defect::Resize { factor, share } => {
                 let patch = Patch::new(s, share);
@@ -295,7 +304,9 @@ impl Defect {
             Defect::Spin { degrees, share } => {
                 let patch = Patch::new(s, share);
                 let angle = degrees.to_radians();
-                (0..rest.len()).map(|v| turned(rest[v], patch.center, patch.normal, angle * patch.weights[v])).collect()
+                (0..rest.len())
+                    .map(|v| turned(rest[v], patch.center, patch.normal, angle * patch.weights[v]))
+                    .collect()
             }
             Defect::Fold { degrees, share } => folded(s, &Patch::new(s, share), degrees.to_radians()),
             Defect::CrossSection { factor } => cross_section(s, factor),
@@ -312,7 +323,13 @@ impl Defect {
                 Err(format!("`{key}` must be a finite number > 0, not {v}"))
             }
         };
-        let share = |v: f64| if v > 0.0 && v <= 0.5 { Ok(()) } else { Err(format!("`share` must be in (0, 0.5], not {v}")) };
+        let share = |v: f64| {
+            if v > 0.0 && v <= 0.5 {
+                Ok(())
+            } else {
+                Err(format!("`share` must be in (0, 0.5], not {v}"))
+            }
+        };
         match *self {
             Defect::Resize { factor, share: s } => positive("factor", factor).and(share(s)),
             Defect::Fold { degrees, share: s } | Defect::Spin { degrees, share: s } => {

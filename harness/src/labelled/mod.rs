@@ -127,7 +127,10 @@ fn entry_error(path: &Path, index: usize, name: &str, message: String) -> Harnes
 pub(crate) fn check_label(label: Label, kinds: &[String], also: &[String]) -> Result<(), String> {
     for (key, list) in [("kinds", kinds), ("also", also)] {
         if let Some(k) = list.iter().find(|k| !REASON_KINDS.contains(&k.as_str())) {
-            return Err(format!("{key} = [.. \"{k}\" ..]: not a reason kind (one of {})", REASON_KINDS.join(", ")));
+            return Err(format!(
+                "{key} = [.. \"{k}\" ..]: not a reason kind (one of {})",
+                REASON_KINDS.join(", ")
+            ));
         }
     }
     match (label, kinds.is_empty()) {
@@ -149,8 +152,8 @@ impl LabelledSet {
         paths.sort();
         let mut set = LabelledSet::default();
         for path in paths {
-            let text =
-                std::fs::read_to_string(&path).map_err(|error| HarnessError::Io { path: path.clone(), error })?;
+            let text = std::fs::read_to_string(&path)
+                .map_err(|error| HarnessError::Io { path: path.clone(), error })?;
             let file: LabelledFile = toml::from_str(&text)
                 .map_err(|e| HarnessError::Config { path: path.clone(), message: e.to_string() })?;
             for (i, e) in file.entry.iter().enumerate() {
@@ -203,7 +206,12 @@ pub(crate) fn load_scenario(
                 spec.procedural = None;
                 DataSource::Survey(dir.clone())
             }
-            (_, None) => return Err(HarnessError::Config { path, message: "source = \"survey\": the scenario has no `survey`".into() }),
+            (_, None) => {
+                return Err(HarnessError::Config {
+                    path,
+                    message: "source = \"survey\": the scenario has no `survey`".into(),
+                })
+            }
             _ => return Ok(Err("needs the survey data (--survey-dir or DEFORM_SURVEY_DIR)".into())),
         },
         Source::Procedural => {
@@ -260,8 +268,15 @@ pub fn judge_all(
         let several = meshes.len() > 1;
         for (scenario, rest) in meshes {
             let name = if several { format!("{} [{}]", e.name, scenario.spec.name) } else { e.name.clone() };
-            let judgement = judge_entry(e, scenario, rest, rules).map_err(|m| entry_error(file, i, &e.name, m))?;
-            judged.push(Judged { name, label: e.label, kinds: e.kinds.clone(), also: e.also.clone(), judgement });
+            let judgement =
+                judge_entry(e, scenario, rest, rules).map_err(|m| entry_error(file, i, &e.name, m))?;
+            judged.push(Judged {
+                name,
+                label: e.label,
+                kinds: e.kinds.clone(),
+                also: e.also.clone(),
+                judgement,
+            });
         }
     }
     Ok((judged, skipped))
@@ -278,7 +293,10 @@ fn judge_entry(
     if let Some(Defect::Miss { region: Some(name), .. }) = &e.defect {
         if !handles.regions().iter().any(|r| &r.name == name) {
             let names: Vec<&str> = handles.regions().iter().map(|r| r.name.as_str()).collect();
-            return Err(format!("defect.region = \"{name}\": no such region (there are {})", names.join(", ")));
+            return Err(format!(
+                "defect.region = \"{name}\": no such region (there are {})",
+                names.join(", ")
+            ));
         }
     }
     let shape = Shape::new(&scenario.mesh, handles);
@@ -294,7 +312,15 @@ fn judge_entry(
         jitter(&mut result, e.noise * shape.diagonal);
     }
     let steps = [(handles, &targets)];
-    Ok(measures::judge_on(rules, rest, &scenario.mesh, &scenario.topology, &result, &steps, Reference::Missing))
+    Ok(measures::judge_on(
+        rules,
+        rest,
+        &scenario.mesh,
+        &scenario.topology,
+        &result,
+        &steps,
+        Reference::Missing,
+    ))
 }
 
 /// Add a deterministic pseudo-random offset of up to `amplitude` per coordinate to `positions`.

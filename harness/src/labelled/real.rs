@@ -70,6 +70,9 @@ fn run(
     Ok(result.positions)
 }
 
+/// A scenario's meshes and its reference result.
+type Loaded = (Meshes, Vec<[f64; 3]>);
+
 /// Run and judge every real case of `entries` with the methods of `catalog`.
 pub fn judge_real(
     entries: &[(PathBuf, RealSpec)],
@@ -77,7 +80,7 @@ pub fn judge_real(
     rules: &VerdictRules,
     dirs: &DataDirs,
 ) -> Result<(Vec<Judged>, Vec<Skipped>), HarnessError> {
-    let mut cache: BTreeMap<(PathBuf, Source), Result<(Meshes, Vec<[f64; 3]>), String>> = BTreeMap::new();
+    let mut cache: BTreeMap<(PathBuf, Source), Result<Loaded, String>> = BTreeMap::new();
     let (mut judged, mut skipped) = (Vec::new(), Vec::new());
     for (i, (file, e)) in entries.iter().enumerate() {
         let fail = |m: String| super::entry_error(file, i, &e.name, m);
@@ -110,7 +113,11 @@ pub fn judge_real(
         };
         let (scenario, rest) = &meshes[0];
         if scenario.steps.len() != 1 {
-            return Err(fail(format!("scenario `{}` has {} edit steps; a real case takes one", scenario.spec.name, scenario.steps.len())));
+            return Err(fail(format!(
+                "scenario `{}` has {} edit steps; a real case takes one",
+                scenario.spec.name,
+                scenario.steps.len()
+            )));
         }
         let step = &scenario.steps[0];
         let targets = step.targets(scenario.mesh.positions()).map_err(|m| fail(m.to_string()))?;
@@ -122,7 +129,13 @@ pub fn judge_real(
         };
         let judgement =
             measures::judge_on(rules, rest, &scenario.mesh, &scenario.topology, &positions, &steps, against);
-        judged.push(Judged { name: e.name.clone(), label: e.label, kinds: e.kinds.clone(), also: e.also.clone(), judgement });
+        judged.push(Judged {
+            name: e.name.clone(),
+            label: e.label,
+            kinds: e.kinds.clone(),
+            also: e.also.clone(),
+            judgement,
+        });
     }
     Ok((judged, skipped))
 }
