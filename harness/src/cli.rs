@@ -125,6 +125,19 @@ enum Command {
         #[arg(long, default_value_t = crate::comparison::DEFAULT_MIN_CHANGE)]
         min_change: f64,
     },
+    /// Judge the labelled verdict set (known-good and known-bad results, README "Labelled verdict
+    /// set") by verdicts.toml and print the precision/recall table per rule kind; exit 1 when a bad
+    /// case misses one of its expected kinds or more than 2% of the good cases are flagged.
+    VerdictCheck {
+        /// The set's directory [default: labelled/ in the configuration directory].
+        #[arg(long)]
+        labelled: Option<PathBuf>,
+        /// Also run the `[[real]]` cases: the suite's methods on their scenarios (minutes).
+        #[arg(long)]
+        real: bool,
+        #[command(flatten)]
+        common: Common,
+    },
     /// List the registered methods and the scenarios.
     List(Common),
     /// The configuration built into this binary (used where there is no ./configs).
@@ -431,8 +444,47 @@ where
             );
             Ok(ExitCode::SUCCESS)
         }
+        Command::VerdictCheck { labelled, real, common } => {
+            verdict_check(labelled, real, common, &command_line)
+        }
         Command::List(common) => list(common, &command_line),
     }
+}
+
+/// `verdict-check`: the labelled set judged, its table printed.
+fn verdict_check(
+    labelled: Option<PathBuf>,
+    real: bool,
+    common: Common,
+    command_line: &[String],
+) -> anyhow::Result<ExitCode> {
+    use crate::labelled::{judge_all, real::judge_real, tally, DataDirs, LabelledSet, Tally};
+    let options = common.options(Vec::new(), Vec::new(), command_line)?;
+    let dir = labelled.unwrap_or_else(|| options.configs_dir.join("labelled"));
+    let rules = measures::VerdictRules::load(&options.configs_dir.join("verdicts.toml"))?;
+    let set = LabelledSet::load(&dir)?;
+    let dirs = DataDirs { survey: options.survey_dir.clone() };
+    let (mut judged, mut skipped) = judge_all(&set, &rules, &dirs)?;
+    if real {
+        let catalog = crate::config::MethodCatalog::load(&options.configs_dir.join("methods.toml"))?;
+        let (j, s) = judge_real(&set.real, &catalog, &rules, &dirs)?;
+        judged.extend(j);
+        skipped.extend(s);
+    }
+    for s in &skipped {
+        println!("skipped: {}: {}", s.name, s.reason);
+    }
+    print!("{}", tally::case_lines(&judged));
+    let tally = Tally::of(&judged, &skipped);
+    println!("\n{}", tally.table());
+    for (name, missed) in &tally.bad_missed {
+        println!("not flagged: {name}: {}", missed.join(", "));
+    }
+    let good_ok = tally.good_flagged_share() <= 0.02;
+    if !good_ok {
+        println!("good cases flagged: {}", tally.good_flagged.join("; "));
+    }
+    Ok(if tally.bad_missed.is_empty() && good_ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
 /// `all`: every method on every scenario, published and gated (or one shard of it).

@@ -28,6 +28,7 @@ pub mod comparison;
 pub mod config;
 pub mod error;
 pub mod history;
+pub mod labelled;
 pub mod memory;
 pub mod method_check;
 pub mod metrics;
