@@ -478,13 +478,16 @@ fn verdict_check(
     let tally = Tally::of(&judged, &skipped);
     println!("\n{}", tally.table());
     for (name, missed) in &tally.bad_missed {
-        println!("not flagged: {name}: {}", missed.join(", "));
+        println!("flagged, but not as expected: {name}: missed {}", missed.join(", "));
     }
     let good_ok = tally.good_flagged_share() <= 0.02;
     if !good_ok {
         println!("good cases flagged: {}", tally.good_flagged.join("; "));
     }
-    Ok(if tally.bad_missed.is_empty() && good_ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
+    for name in &tally.bad_unflagged {
+        println!("bad case not flagged: {name}");
+    }
+    Ok(if tally.bad_unflagged.is_empty() && good_ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
 /// `all`: every method on every scenario, published and gated (or one shard of it).

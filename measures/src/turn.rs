@@ -132,7 +132,9 @@ const GAP_SAMPLES: usize = 400;
 
 /// The turn (radians) the handles ask of the free surface: the largest rotation of a region from
 /// its rest positions to its targets ([`region_turn`]), plus the largest bend two regions need,
-/// `2 atan(d / g)` for regions whose centroids moved apart by `d` across a rest gap `g` (the
+/// `2 atan(d / g)` for regions whose centroids moved apart by `d` across a rest gap `g`, `d` taken
+/// after turning their rest offset by either region's own rotation (the smaller; so a rigid motion
+/// of both together asks no bend) (the
 /// steepest slope of an S-bend between two ends held parallel is about that; the survey plane's
 /// lift across its free band asks 70 deg, and its results turn 63-77). `bends` says which pairs of
 /// regions count.
@@ -141,9 +143,16 @@ pub fn asked_turn(rest: &[[f64; 3]], handles: &HandleSet, targets: &HandleTarget
     for (v, t) in handles.constrained().zip(targets.positions()) {
         target_of[v as usize] = Some(*t);
     }
-    // Per region: (rest, target) pairs, the centroid displacement, a sample for the gaps, and
-    // whether it is held where it is.
-    let regions: Vec<(Vec<([f64; 3], [f64; 3])>, [f64; 3], Vec<[f64; 3]>, bool)> = handles
+    // Per region: its rest and target centroids, its rotation, a sample for the gaps, and whether
+    // it is held where it is.
+    struct Region {
+        rest: [f64; 3],
+        target: [f64; 3],
+        rotation: [[f64; 3]; 3],
+        sample: Vec<[f64; 3]>,
+        held: bool,
+    }
+    let regions: Vec<Region> = handles
         .regions()
         .iter()
         .map(|r| {
@@ -153,29 +162,36 @@ pub fn asked_turn(rest: &[[f64; 3]], handles: &HandleSet, targets: &HandleTarget
                 .filter_map(|&v| target_of[v as usize].map(|t| (rest[v as usize], t)))
                 .collect();
             let n = pairs.len().max(1) as f64;
-            let mut moved = [0.0; 3];
+            let (mut c0, mut c1) = ([0.0; 3], [0.0; 3]);
             for (p, t) in &pairs {
                 for a in 0..3 {
-                    moved[a] += (t[a] - p[a]) / n;
+                    c0[a] += p[a] / n;
+                    c1[a] += t[a] / n;
                 }
             }
             let stride = pairs.len().div_ceil(GAP_SAMPLES).max(1);
             let sample = pairs.iter().step_by(stride).map(|(p, _)| *p).collect();
             let held = pairs.iter().all(|(p, t)| p == t);
-            (pairs, moved, sample, held)
+            Region { rest: c0, target: c1, rotation: region_rotation(&pairs), sample, held }
         })
         .collect();
-    let rotation = regions.iter().map(|(pairs, ..)| region_turn(pairs)).fold(0.0, f64::max);
+    let rotation = regions.iter().map(|r| rotation_angle(&r.rotation)).fold(0.0, f64::max);
     let mut bend: f64 = 0.0;
-    for (i, (_, di, si, held_i)) in regions.iter().enumerate() {
-        for (_, dj, sj, held_j) in &regions[i + 1..] {
-            if bends == Bends::FromHeld && !held_i && !held_j {
+    for (i, ri) in regions.iter().enumerate() {
+        for rj in &regions[i + 1..] {
+            if bends == Bends::FromHeld && !ri.held && !rj.held {
                 continue;
             }
-            let apart = norm(sub(*di, *dj));
-            let gap = si
-                .iter()
-                .flat_map(|p| sj.iter().map(move |q| norm(sub(*p, *q))))
+            // How far the regions moved apart beyond what turning their rest offset with either
+            // region's own rotation explains: 0 for a rigid motion of both together (issue 62: a
+            // common rotation used to count as a bend, and "asked" 55 deg more for a 30 deg turn).
+            let (now, then) = (sub(ri.target, rj.target), sub(ri.rest, rj.rest));
+            let apart = [&ri.rotation, &rj.rotation]
+                .map(|r| norm(sub(now, rotate(r, then))))
+                .into_iter()
+                .fold(f64::INFINITY, f64::min);
+            let gap = (ri.sample.iter())
+                .flat_map(|p| rj.sample.iter().map(move |q| norm(sub(*p, *q))))
                 .fold(f64::INFINITY, f64::min);
             if apart > 0.0 && gap.is_finite() {
                 bend = bend.max(2.0 * apart.atan2(gap));
@@ -230,8 +246,14 @@ pub fn one_ring_turns(rest: &[[f64; 3]], result: &[[f64; 3]], topology: &Topolog
 /// The angle (radians) of the rotation that best maps the `(rest, target)` point pairs of one
 /// region (Kabsch, about their centroids); 0 for fewer than two points.
 pub fn region_turn(pairs: &[([f64; 3], [f64; 3])]) -> f64 {
+    rotation_angle(&region_rotation(pairs))
+}
+
+/// The rotation that best maps the `(rest, target)` point pairs of one region (Kabsch, about their
+/// centroids); the identity for fewer than two points.
+pub fn region_rotation(pairs: &[([f64; 3], [f64; 3])]) -> [[f64; 3]; 3] {
     if pairs.len() < 2 {
-        return 0.0;
+        return [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     }
     let n = pairs.len() as f64;
     let centroid = |pick: fn(&([f64; 3], [f64; 3])) -> [f64; 3]| {
@@ -245,7 +267,12 @@ pub fn region_turn(pairs: &[([f64; 3], [f64; 3])]) -> f64 {
         c
     };
     let (c0, c1) = (centroid(|p| p.0), centroid(|p| p.1));
-    turn_of(&cross_covariance(pairs.iter().map(|(p, q)| (sub(*p, c0), sub(*q, c1)))))
+    closest_rotation(&cross_covariance(pairs.iter().map(|(p, q)| (sub(*p, c0), sub(*q, c1)))))
+}
+
+/// `r v`.
+fn rotate(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|a| r[a][0] * v[0] + r[a][1] * v[1] + r[a][2] * v[2])
 }
 
 /// The angle (radians, in `[0, pi]`) of the rotation closest to the cross-covariance `m`.

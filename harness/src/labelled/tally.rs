@@ -43,6 +43,11 @@ pub struct Tally {
     pub bad: usize,
     /// Bad cases missing one of their expected kinds, with the kinds missed.
     pub bad_missed: Vec<(String, Vec<String>)>,
+    /// Bad cases with no reason at all: the verdict called them `ok`.
+    pub bad_unflagged: Vec<String>,
+    pub tolerated: usize,
+    /// Tolerated cases with any reason.
+    pub tolerated_flagged: Vec<String>,
     pub skipped: usize,
 }
 
@@ -58,6 +63,13 @@ impl Tally {
         tally.rules = REASON_KINDS.iter().map(|k| RuleCounts { kind: k, ..RuleCounts::default() }).collect();
         for case in judged {
             let got = fired(case);
+            if case.label == Label::Tolerated {
+                tally.tolerated += 1;
+                if !case.judgement.reasons.is_empty() {
+                    tally.tolerated_flagged.push(case.name.clone());
+                }
+                continue;
+            }
             for counts in &mut tally.rules {
                 let expected = case.kinds.iter().any(|k| k == counts.kind);
                 let tolerated = case.also.iter().any(|k| k == counts.kind);
@@ -83,7 +95,11 @@ impl Tally {
                     if !missed.is_empty() {
                         tally.bad_missed.push((case.name.clone(), missed));
                     }
+                    if case.judgement.reasons.is_empty() {
+                        tally.bad_unflagged.push(case.name.clone());
+                    }
                 }
+                Label::Tolerated => unreachable!("counted above"),
             }
         }
         tally
@@ -114,12 +130,16 @@ impl Tally {
         }
         let _ = writeln!(
             out,
-            "\n{} good cases, {} flagged ({:.1}%); {} bad cases, {} caught with every expected kind; {} skipped",
+            "\n{} good cases, {} flagged ({:.1}%); {} bad cases, {} flagged, {} of them with every expected kind; \
+             {} tolerated cases, {} flagged; {} skipped",
             self.good,
             self.good_flagged.len(),
             100.0 * self.good_flagged_share(),
             self.bad,
+            self.bad - self.bad_unflagged.len(),
             self.bad - self.bad_missed.len(),
+            self.tolerated,
+            self.tolerated_flagged.len(),
             self.skipped
         );
         out
@@ -133,6 +153,7 @@ pub fn case_lines(judged: &[Judged]) -> String {
         let truth = match case.label {
             Label::Good => "good".to_string(),
             Label::Bad => format!("bad: {}", case.kinds.join(", ")),
+            Label::Tolerated => "tolerated".to_string(),
         };
         let verdict = if case.judgement.reasons.is_empty() {
             "ok".to_string()
