@@ -263,7 +263,8 @@ impl VerdictRules {
             } else {
                 continue;
             };
-            let asked = if asked == AskedSize::NONE {
+            // Within half a percent of no change is printed as none (round-off of the targets).
+            let asked = if (asked.low - 1.0).abs() < 5e-3 && (asked.high - 1.0).abs() < 5e-3 {
                 "the handles ask no change".to_string()
             } else {
                 let percent = |f: f64| format!("{:+.0}%", 100.0 * (f - 1.0));
