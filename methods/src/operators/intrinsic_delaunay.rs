@@ -38,7 +38,7 @@ use super::{MassKind, DEGENERATE_FACE_RATIO};
 /// survey plane: 1e-12 leaves nearly cocircular quads unflipped that libigl flips (3e-10 relative
 /// difference on small entries), 1e-14 agrees to 2e-12, 0 flips the cylinder's rounding noise
 /// (1158 flips instead of 0).
-const FLIP_TOLERANCE: f64 = 1e-14;
+pub(super) const FLIP_TOLERANCE: f64 = 1e-14;
 
 /// Flip budget per edge (see the module documentation).
 const FLIPS_PER_EDGE: usize = 100;
@@ -234,7 +234,12 @@ impl IntrinsicTriangulation {
         2.0 * half_cotangents(self.opposite_lengths(f))[(h % 3 + 2) % 3]
     }
 
-    pub(super) fn flip_to_delaunay(&mut self) -> Result<(), IntrinsicDelaunayError> {
+    fn flip_to_delaunay(&mut self) -> Result<(), IntrinsicDelaunayError> {
+        self.flip_to_delaunay_with(FLIP_TOLERANCE)
+    }
+
+    /// Flip every interior edge with `cot a + cot b < -tolerance` (see the module documentation).
+    pub(super) fn flip_to_delaunay_with(&mut self, tolerance: f64) -> Result<(), IntrinsicDelaunayError> {
         let n_halfedges = self.twin.len();
         // Edge ids: one per twin pair / boundary halfedge. A flip keeps the flipped edge's id, and the
         // other four edges keep theirs while their halfedges change slots.
@@ -266,7 +271,7 @@ impl IntrinsicTriangulation {
             queued[e] = false;
             let h = halfedge_of[e];
             let t = self.twin[h];
-            if self.opposite_cot(h) + self.opposite_cot(t) >= -FLIP_TOLERANCE {
+            if self.opposite_cot(h) + self.opposite_cot(t) >= -tolerance {
                 continue;
             }
             if self.flips >= limit {

@@ -52,7 +52,7 @@
 use faer::sparse::{SparseColMat, Triplet};
 use meshes::vector::{cross, dot, norm, sub};
 
-use super::intrinsic_delaunay::{edge_groups, halfedge_lengths};
+use super::intrinsic_delaunay::{edge_groups, halfedge_lengths, FLIP_TOLERANCE};
 use super::{IntrinsicDelaunayError, IntrinsicTriangulation, MassKind};
 
 /// SC20's relative mollification `delta / mean edge length`, robust-laplacian's default
@@ -65,6 +65,9 @@ pub struct TuftedDelaunay {
     cover: IntrinsicTriangulation,
     mollification: f64,
     non_manifold_edges: usize,
+    /// Whether [`Self::cotan_laplacian`] sets the flip tolerance's rounding residue to 0 (only at
+    /// the default tolerance; a looser one keeps its negative weights, as robust-laplacian does).
+    clamp_residue: bool,
 }
 
 impl TuftedDelaunay {
@@ -78,6 +81,18 @@ impl TuftedDelaunay {
         positions: &[[f64; 3]],
         triangles: &[[u32; 3]],
         mollify_factor: f64,
+    ) -> Result<Self, IntrinsicDelaunayError> {
+        Self::with_flip_tolerance(positions, triangles, mollify_factor, FLIP_TOLERANCE)
+    }
+
+    /// [`Self::new`] flipping only edges with `cot a + cot b < -flip_tolerance` (default 1e-14).
+    /// For the cross-check: robust-laplacian (geometry-central's `flipToDelaunay`, `delaunayEPS =
+    /// 1e-6` on the half-sum) is `flip_tolerance = 2e-6`, which leaves weights down to `-1e-6`.
+    pub fn with_flip_tolerance(
+        positions: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+        mollify_factor: f64,
+        flip_tolerance: f64,
     ) -> Result<Self, IntrinsicDelaunayError> {
         let n_faces = triangles.len();
         let mut mesh_length = halfedge_lengths(positions, triangles)?;
@@ -150,8 +165,8 @@ impl TuftedDelaunay {
 
         let mut cover =
             IntrinsicTriangulation::from_halfedges(positions.len(), cover_triangles, twin, length)?;
-        cover.flip_to_delaunay()?;
-        Ok(Self { cover, mollification, non_manifold_edges })
+        cover.flip_to_delaunay_with(flip_tolerance)?;
+        Ok(Self { cover, mollification, non_manifold_edges, clamp_residue: flip_tolerance <= FLIP_TOLERANCE })
     }
 
     /// The cover flipped to intrinsic Delaunay: `2 #F` faces (front copies first), every edge
@@ -185,7 +200,7 @@ impl TuftedDelaunay {
                 // order that differs between (i, j) and (j, i) by an ulp; mirroring keeps L exactly
                 // symmetric. Negative values are flip-tolerance rounding (module documentation).
                 if i < j {
-                    let w = 0.5 * values[idx].max(0.0);
+                    let w = 0.5 * if self.clamp_residue { values[idx].max(0.0) } else { values[idx] };
                     entries.push(Triplet::new(i, j, w));
                     entries.push(Triplet::new(j, i, w));
                     diagonal[i] -= w;
