@@ -1,14 +1,16 @@
 //! Cross-checks against libigl on the survey meshes (run by `scripts/test`, which installs the pinned
 //! Python packages; without `$DEFORM_SURVEY_DIR` on the procedural look-alikes at the survey's sizes,
 //! written as the same files, with the same tolerances: `support::survey_meshes`): operators (also the intrinsic Delaunay Laplacian, on the real meshes too when
-//! `$DEFORM_REAL_MESHES_DIR` is set) to 1e-10 relative, ARAP to RMS distance <= 1e-3 of the bbox
+//! `$DEFORM_REAL_MESHES_DIR` is set; and the tufted Laplacian against robust-laplacian) to 1e-10 relative, ARAP to RMS distance <= 1e-3 of the bbox
 //! diagonal.
 
 mod support;
 
 use std::collections::HashMap;
 
-use methods::operators::{cotan_laplacian, lumped_mass, IntrinsicTriangulation, MassKind};
+use methods::operators::{
+    cotan_laplacian, lumped_mass, IntrinsicTriangulation, MassKind, TuftedDelaunay, MOLLIFY_FACTOR,
+};
 use methods::NoObserver;
 use support::{igl_reference, python, read_rows, survey_case, survey_meshes};
 
@@ -108,6 +110,73 @@ fn intrinsic_delaunay_laplacian_matches_libigl() {
         let name = mesh_path.file_name().unwrap().to_string_lossy();
         println!("{name}: {} flips, intrinsic_delaunay_cotmatrix max relative error {err:.2e}", t.flips());
         assert!(err <= 1e-10, "{name}: intrinsic Delaunay Laplacian differs from libigl's by {err:e}");
+    }
+}
+
+/// The tufted Laplacian (our default weights) against robust-laplacian's `mesh_laplacian` with
+/// `mollify_factor = 0` (Sharp & Crane 2020's implementation in geometry-central), on the survey
+/// meshes (bar and plane are open), the real meshes and, with `$DEFORM_DATASET_DIR`, open dataset
+/// meshes whose plain intrinsic Delaunay weights are negative on the boundary. No mesh here needs
+/// mollification (ours reports `eps = 0`, so the default factor leaves the lengths as they are).
+/// robust-laplacian leaves an edge unflipped while `(cot a + cot b) / 2 >= -1e-6` (geometry-central's
+/// `delaunayEPS`), ours down to `-0.5e-14`: at its tolerance the matrices agree to rounding; at ours
+/// they differ where robust-laplacian keeps small negative weights (the survey plane: 1388).
+#[test]
+fn tufted_laplacian_matches_robust_laplacian() {
+    let Some(py) = python() else { return };
+    let dir = survey_meshes().dir;
+    let mut paths: Vec<std::path::PathBuf> = MESHES.iter().map(|n| dir.join(format!("{n}.off"))).collect();
+    if let Some(real) = std::env::var_os("DEFORM_REAL_MESHES_DIR").and_then(|_| support::real_meshes_dir()) {
+        paths.extend(["decimated-knight.off", "bunny.off"].map(|f| real.join(f)));
+    }
+    if let Some(dataset) = std::env::var_os("DEFORM_DATASET_DIR").and_then(|_| support::dataset_dir()) {
+        paths.extend(["manysmallholes.obj", "alligator.obj", "africanhead.obj"].map(|f| dataset.join(f)));
+    }
+    for mesh_path in paths {
+        let mesh = meshes::io::read_mesh(&mesh_path).unwrap();
+        let out = tempfile::tempdir().unwrap();
+        igl_reference(&py, &["tufted", mesh_path.to_str().unwrap(), out.path().to_str().unwrap()]);
+        let theirs: HashMap<(usize, usize), f64> = read_rows(&out.path().join("tufted_laplacian.txt"))
+            .into_iter()
+            .map(|r| ((r[0] as usize, r[1] as usize), r[2]))
+            .collect();
+        let t = TuftedDelaunay::new(mesh.positions(), mesh.triangles(), MOLLIFY_FACTOR).unwrap();
+        assert_eq!(t.mollification(), 0.0);
+        let default = sparse_relative_error(&entry_map(&t.cotan_laplacian()), &theirs);
+        // robust-laplacian flips only below its `delaunayEPS`: the same tolerance here.
+        let same =
+            TuftedDelaunay::with_flip_tolerance(mesh.positions(), mesh.triangles(), 0.0, 2e-6).unwrap();
+        let err = sparse_relative_error(&entry_map(&same.cotan_laplacian()), &theirs);
+        let name = mesh_path.file_name().unwrap().to_string_lossy();
+        let scale = theirs.values().fold(0.0f64, |m, v| m.max(v.abs()));
+        let their_negative = theirs.iter().filter(|(k, v)| k.0 != k.1 && **v < -1e-12 * scale).count();
+        println!(
+            "{name}: {} cover flips, tufted Laplacian max relative error {err:.2e} at robust-laplacian's \
+             flip tolerance, {default:.2e} at ours (robust-laplacian weights below -1e-12 x largest: \
+             {their_negative}, ours: 0)",
+            t.cover().flips()
+        );
+        assert!(err <= 1e-10, "{name}: tufted Laplacian differs from robust-laplacian's by {err:e}");
+        if their_negative == 0 {
+            assert!(
+                default <= 1e-10,
+                "{name}: tufted Laplacian differs from robust-laplacian's by {default:e}"
+            );
+        }
+        // The barycentric lumped mass of an intrinsic triangulation depends on how cocircular quads
+        // are split, which the flip order decides (the cotan weights do not), so per vertex it is
+        // only reported; the totals (the surface's area) agree.
+        let theirs: Vec<f64> =
+            read_rows(&out.path().join("tufted_mass.txt")).into_iter().map(|r| r[0]).collect();
+        let ours = t.lumped_mass(MassKind::Barycentric);
+        assert_eq!(ours.len(), theirs.len());
+        let per_vertex = ours.iter().zip(&theirs).map(|(a, b)| (a - b).abs() / b.abs()).fold(0.0, f64::max);
+        let (a, b) = (ours.iter().sum::<f64>(), theirs.iter().sum::<f64>());
+        println!(
+            "{name}: tufted mass: totals {:.1e} apart, per vertex up to {per_vertex:.1e}",
+            (a - b).abs() / b
+        );
+        assert!((a - b).abs() <= 1e-10 * b, "{name}: tufted mass total {a} vs robust-laplacian's {b}");
     }
 }
 

@@ -59,7 +59,7 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
             assert!(!row["status"].starts_with("failed"), "{scenario}/{method}: {}", row["status"]);
             assert_eq!(row["mesh_source"], "survey");
             assert_eq!(
-                row["laplacian_weights"], "intrinsic_delaunay",
+                row["laplacian_weights"], "tufted_delaunay",
                 "{scenario}/{method}: the default is reported"
             );
             let residual = support::num(row, "handle_residual_over_diag");

@@ -17,7 +17,9 @@ pub struct RestGeometry {
     pub(crate) volume: Option<f64>,
     /// Bounding-box diagonal.
     pub diagonal: f64,
-    /// The reference's energy on this mesh (`None` where its Laplacian cannot be built).
+    /// The reference's energy on this mesh (`None` where its Laplacian cannot be built), with the
+    /// tufted intrinsic Delaunay weights whatever the methods run with: all `>= 0`, so the energy is
+    /// never negative (the plain intrinsic Delaunay weights are negative on some boundary edges).
     pub(crate) arap_energy: Option<methods::arap::ArapEnergy>,
 }
 
@@ -32,7 +34,11 @@ impl RestGeometry {
             lengths: edge_lengths(p, topology.edges()),
             volume: topology.is_closed().then(|| signed_volume(p, t)),
             diagonal: mesh.bbox_diagonal(),
-            arap_energy: methods::arap::ArapEnergy::new(mesh, Default::default()).ok(),
+            arap_energy: methods::arap::ArapEnergy::new(
+                mesh,
+                methods::operators::LaplacianWeights::TuftedDelaunay,
+            )
+            .ok(),
         }
     }
 }

@@ -7,7 +7,7 @@
 //!
 //! Decisions the paper leaves open (see also the tests):
 //! - `L` is a cotangent Laplacian without mass normalization (libigl `cotmatrix`); eq 1 is
-//!   invariant to the sign of `L`. The weights (`weights`, default `intrinsic_delaunay`) enter
+//!   invariant to the sign of `L`. The weights (`weights`, default `tufted_delaunay`) enter
 //!   everything `L` does: the rest coordinates `delta = L X_rest`, the normal matrix `L^T L` and the
 //!   right-hand side `L^T delta(X)`; the rest shape stays a fixed point for any weights since both
 //!   sides use the same `L`.

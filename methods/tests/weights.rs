@@ -14,14 +14,19 @@ use methods::operators::{
 use methods::registry::create;
 use methods::{HandleRegion, HandleSet, HandleTargets, NoObserver};
 
-const ALL: [LaplacianWeights; 3] =
-    [LaplacianWeights::Cotan, LaplacianWeights::Clamped, LaplacianWeights::IntrinsicDelaunay];
+const ALL: [LaplacianWeights; 4] = [
+    LaplacianWeights::Cotan,
+    LaplacianWeights::Clamped,
+    LaplacianWeights::IntrinsicDelaunay,
+    LaplacianWeights::TuftedDelaunay,
+];
 
 fn name(w: LaplacianWeights) -> &'static str {
     match w {
         LaplacianWeights::Cotan => "cotan",
         LaplacianWeights::Clamped => "clamped",
         LaplacianWeights::IntrinsicDelaunay => "intrinsic_delaunay",
+        LaplacianWeights::TuftedDelaunay => "tufted_delaunay",
     }
 }
 
@@ -325,7 +330,15 @@ fn arap_rest_shape_is_a_fixed_point_for_every_weight() {
     let strip = sliver_strip(20, 0.05);
     for (label, mesh, weights) in [
         ("bar", &bar, &ALL[..]),
-        ("sliver strip", &strip, &[LaplacianWeights::Clamped, LaplacianWeights::IntrinsicDelaunay][..]),
+        (
+            "sliver strip",
+            &strip,
+            &[
+                LaplacianWeights::Clamped,
+                LaplacianWeights::IntrinsicDelaunay,
+                LaplacianWeights::TuftedDelaunay,
+            ][..],
+        ),
     ] {
         let (lo, hi) = (mesh.bbox().0[0], mesh.bbox().1[0]);
         let handles = if label == "bar" {
@@ -344,7 +357,7 @@ fn arap_rest_shape_is_a_fixed_point_for_every_weight() {
 }
 
 #[test]
-fn cotan_arap_folds_the_sliver_band_and_intrinsic_delaunay_does_not() {
+fn cotan_arap_folds_the_sliver_band_and_the_delaunay_weights_do_not() {
     let mesh = sliver_strip(20, 0.05);
     let handles = handles_by(&mesh, |p| p[0] < 1.6, |p| p[0] > 18.4);
     // Push the handle end 6 cells towards the fixed end, in the plane; and twist it by 2 radians
@@ -358,9 +371,12 @@ fn cotan_arap_folds_the_sliver_band_and_intrinsic_delaunay_does_not() {
     for (label, targets) in [("compress", &compress), ("twist", &twist)] {
         let fold = |w| max_dihedral_change(&mesh, &arap(w, &mesh, &handles, targets, 500));
         let (cotan, intrinsic) = (fold(LaplacianWeights::Cotan), fold(LaplacianWeights::IntrinsicDelaunay));
+        let tufted = fold(LaplacianWeights::TuftedDelaunay);
         println!(
-            "{label}: largest dihedral change cotan {cotan:.1} deg, intrinsic_delaunay {intrinsic:.1} deg"
+            "{label}: largest dihedral change cotan {cotan:.1} deg, intrinsic_delaunay {intrinsic:.1} deg, \
+             tufted_delaunay {tufted:.1} deg"
         );
+        assert!(tufted < 30.0, "{label}: tufted Delaunay ARAP changed a dihedral angle by {tufted} deg");
         assert!(cotan > 90.0, "{label}: expected cotan ARAP to fold the sliver band, got {cotan} deg");
         assert!(
             intrinsic < 30.0,

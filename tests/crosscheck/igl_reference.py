@@ -21,6 +21,13 @@ intrinsic_delaunay MESH OUT_DIR
     OUT_DIR/intrinsic_delaunay_cotmatrix.txt  L of igl.intrinsic_delaunay_cotmatrix(V, F) as COO
                                  triplets, in the format of `operators`' cotmatrix.txt.
 
+tufted MESH OUT_DIR
+    OUT_DIR/tufted_laplacian.txt  -L of robust_laplacian.mesh_laplacian(V, F, mollify_factor=0)
+                                 (Sharp & Crane 2020's tufted Laplacian; robust-laplacian's L is
+                                 positive semi-definite, so it is negated into the project's
+                                 libigl sign), COO triplets in the format of `operators`.
+    OUT_DIR/tufted_mass.txt      diagonal of its lumped mass M, one value per line.
+
 arap MESH CONSTRAINTS ITERATIONS OUT
     CONSTRAINTS: one line per constrained vertex, `index x y z` (target position); blank lines
     and lines starting with '#' are ignored. Runs libigl ARAP with the SPOKES energy, dim 3,
@@ -180,6 +187,18 @@ def cmd_intrinsic_delaunay(args):
     ensure_dir(args.out_dir)
     L, _l_intrinsic, _F_intrinsic = igl.intrinsic_delaunay_cotmatrix(V, F)
     write_coo(os.path.join(args.out_dir, "intrinsic_delaunay_cotmatrix.txt"), L)
+
+
+def cmd_tufted(args):
+    import robust_laplacian  # only this subcommand needs it
+
+    V, F = read_mesh(args.mesh)
+    ensure_dir(args.out_dir)
+    L, M = robust_laplacian.mesh_laplacian(V, F, mollify_factor=0.0)
+    write_coo(os.path.join(args.out_dir, "tufted_laplacian.txt"), -L)
+    with open(os.path.join(args.out_dir, "tufted_mass.txt"), "w") as fh:
+        for v in M.diagonal().tolist():
+            fh.write("%.17g\n" % v)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -388,6 +407,11 @@ def build_parser():
     s.add_argument("mesh")
     s.add_argument("out_dir")
     s.set_defaults(func=cmd_intrinsic_delaunay)
+
+    s = sub.add_parser("tufted", help="robust_laplacian.mesh_laplacian (tufted Laplacian), unmollified")
+    s.add_argument("mesh")
+    s.add_argument("out_dir")
+    s.set_defaults(func=cmd_tufted)
 
     s = sub.add_parser("arap", help="libigl ARAP (SPOKES) deformation")
     s.add_argument("mesh")

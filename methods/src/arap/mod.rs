@@ -8,7 +8,7 @@
 //! - global step: `-L X = b`, `b_i = sum_j w_ij / 2 (R_i + R_j)(p_i - p_j)` (SA07 eq 8-9), constrained
 //!   rows eliminated.
 //!
-//! Weights (`weights`, [`LaplacianWeights`]; default `intrinsic_delaunay`). The energy's spokes are
+//! Weights (`weights`, [`LaplacianWeights`]; default `tufted_delaunay`). The energy's spokes are
 //! the vertex pairs the chosen Laplacian couples, with `w_ij = L_ij`, and the global-step matrix is
 //! that same `-L`:
 //! - `cotan` is SA07 as published (and libigl's `arap`); on obtuse triangles `w_ij < 0` makes the
@@ -24,7 +24,11 @@
 //!   non-negative weights the rest covariance `sum_j w_ij e_ij e_ij^T` is positive semi-definite, so
 //!   the local step returns `R = I` at rest (identity targets give zero motion; tested in
 //!   `methods/tests/weights.rs`). Parallel intrinsic edges are summed in `L`; a self-edge has
-//!   `e_ii = 0` and drops out.
+//!   `e_ii = 0` and drops out. Boundary edges are never flipped, so a boundary edge opposite an
+//!   obtuse angle keeps a negative weight (and the energy can be negative on open meshes).
+//! - `tufted_delaunay` (default): the same with the tufted cover's intrinsic Delaunay edges (Sharp &
+//!   Crane 2020, [`crate::operators::TuftedDelaunay`]): every `w_ij >= 0`, boundary edges included,
+//!   so the energy is a sum of non-negative terms on every mesh.
 //!
 //! The initial guess (`start`): `"current"`, the current shape (the rest shape after `precompute`), as
 //! libigl's `arap_solve` with `U = V`, so the two can be compared iteration for iteration

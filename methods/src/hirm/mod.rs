@@ -22,7 +22,7 @@
 //! - The eigenvectors of the *rest* shape are kept throughout (section 4.5); `W(X)` and the
 //!   Laplacian coordinates `sigma(X) = L X` of the base are rebuilt on the current shape, with `L`
 //!   the rest mesh's Laplacian.
-//! - `L`'s weights (`weights`, default `intrinsic_delaunay` as for the other methods): the
+//! - `L`'s weights (`weights`, default `tufted_delaunay` as for the other methods): the
 //!   propagation fields are the eigenvectors of that `L` with its lumped mass (intrinsic areas), and
 //!   the same `L` gives the Laplacian coordinates. Non-negative weights keep the low eigenvectors
 //!   smooth on meshes with obtuse triangles.

@@ -21,7 +21,7 @@
 //!   deformation system is set for the new handles based on the most recently edited result",
 //!   section 5); from the rest shape that is the rest mesh. `L` is the rest mesh's cotangent
 //!   Laplacian; `delta_bar = L X_base`.
-//! - Weights of `L` (`weights`, default `intrinsic_delaunay`): they enter the harmonic fields
+//! - Weights of `L` (`weights`, default `tufted_delaunay`): they enter the harmonic fields
 //!   (`L phi = 0`; with non-negative weights the maximum principle keeps them in `[0, 1]`, so the
 //!   isolines are well defined), the reduced system `W_x^T L^T L W_x`, its right-hand side
 //!   `W_x^T L^T W_delta` and `delta_bar = L X_base`.

@@ -38,7 +38,7 @@ use super::{MassKind, DEGENERATE_FACE_RATIO};
 /// survey plane: 1e-12 leaves nearly cocircular quads unflipped that libigl flips (3e-10 relative
 /// difference on small entries), 1e-14 agrees to 2e-12, 0 flips the cylinder's rounding noise
 /// (1158 flips instead of 0).
-const FLIP_TOLERANCE: f64 = 1e-14;
+pub(super) const FLIP_TOLERANCE: f64 = 1e-14;
 
 /// Flip budget per edge (see the module documentation).
 const FLIPS_PER_EDGE: usize = 100;
@@ -89,34 +89,10 @@ impl IntrinsicTriangulation {
     /// The mesh itself as an intrinsic triangulation (`positions`: `#V x 3`, `triangles`: `#F x 3`,
     /// consistently oriented, manifold), edge lengths from the positions, no flips.
     pub fn from_mesh(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<Self, IntrinsicDelaunayError> {
-        let n_vertices = positions.len();
-        let mut length = Vec::with_capacity(3 * triangles.len());
-        for (face, t) in triangles.iter().enumerate() {
-            if let Some(&vertex) = t.iter().find(|&&v| v as usize >= n_vertices) {
-                return Err(IntrinsicDelaunayError::VertexOutOfRange { face, vertex, n_vertices });
-            }
-            let l: [f64; 3] = std::array::from_fn(|k| {
-                norm(sub(positions[t[(k + 1) % 3] as usize], positions[t[k] as usize]))
-            });
-            // Halfedge k runs from corner k to corner k + 1, so it is opposite corner k + 2.
-            let opposite = [l[1], l[2], l[0]];
-            if !(2.0 * triangle_area(opposite)
-                > DEGENERATE_FACE_RATIO * l.iter().fold(0.0f64, |m, &x| m.max(x * x)))
-            {
-                return Err(IntrinsicDelaunayError::DegenerateFace { face });
-            }
-            length.extend_from_slice(&l);
-        }
+        let length = halfedge_lengths(positions, triangles)?;
         // Twins by sorting halfedges on their unordered vertex pair (deterministic, no hashing).
-        let mut keys: Vec<(u32, u32, usize)> = (0..3 * triangles.len())
-            .map(|h| {
-                let (a, b) = (triangles[h / 3][h % 3], triangles[h / 3][(h % 3 + 1) % 3]);
-                (a.min(b), a.max(b), h)
-            })
-            .collect();
-        keys.sort_unstable();
-        let mut twin = vec![NONE; keys.len()];
-        for group in keys.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        let mut twin = vec![NONE; 3 * triangles.len()];
+        for group in edge_groups(triangles).chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
             let (a, b) = (group[0].0, group[0].1);
             match group {
                 [_] => {}
@@ -131,7 +107,30 @@ impl IntrinsicTriangulation {
                 _ => return Err(IntrinsicDelaunayError::NonManifoldEdge { a, b }),
             }
         }
-        Ok(Self { n_vertices, triangles: triangles.to_vec(), twin, length, flips: 0 })
+        Self::from_halfedges(positions.len(), triangles.to_vec(), twin, length)
+    }
+
+    /// An intrinsic triangulation given by its halfedge arrays (`3 f + k` the halfedge of face `f`
+    /// from corner `k` to `k + 1`): `#F x 3` `triangles`, `3 #F` `twin` (`usize::MAX` on the
+    /// boundary; twins run in opposite directions) and `3 #F` `length` (equal on twins). Fails on a
+    /// face below [`DEGENERATE_FACE_RATIO`].
+    pub(super) fn from_halfedges(
+        n_vertices: usize,
+        triangles: Vec<[u32; 3]>,
+        twin: Vec<usize>,
+        length: Vec<f64>,
+    ) -> Result<Self, IntrinsicDelaunayError> {
+        for face in 0..triangles.len() {
+            let l = [length[3 * face], length[3 * face + 1], length[3 * face + 2]];
+            // Halfedge k runs from corner k to corner k + 1, so it is opposite corner k + 2.
+            let opposite = [l[1], l[2], l[0]];
+            if !(2.0 * triangle_area(opposite)
+                > DEGENERATE_FACE_RATIO * l.iter().fold(0.0f64, |m, &x| m.max(x * x)))
+            {
+                return Err(IntrinsicDelaunayError::DegenerateFace { face });
+            }
+        }
+        Ok(Self { n_vertices, triangles, twin, length, flips: 0 })
     }
 
     /// The intrinsic Delaunay triangulation of the mesh (`#V x 3` positions, `#F x 3` triangles):
@@ -236,6 +235,11 @@ impl IntrinsicTriangulation {
     }
 
     fn flip_to_delaunay(&mut self) -> Result<(), IntrinsicDelaunayError> {
+        self.flip_to_delaunay_with(FLIP_TOLERANCE)
+    }
+
+    /// Flip every interior edge with `cot a + cot b < -tolerance` (see the module documentation).
+    pub(super) fn flip_to_delaunay_with(&mut self, tolerance: f64) -> Result<(), IntrinsicDelaunayError> {
         let n_halfedges = self.twin.len();
         // Edge ids: one per twin pair / boundary halfedge. A flip keeps the flipped edge's id, and the
         // other four edges keep theirs while their halfedges change slots.
@@ -267,7 +271,7 @@ impl IntrinsicTriangulation {
             queued[e] = false;
             let h = halfedge_of[e];
             let t = self.twin[h];
-            if self.opposite_cot(h) + self.opposite_cot(t) >= -FLIP_TOLERANCE {
+            if self.opposite_cot(h) + self.opposite_cot(t) >= -tolerance {
                 continue;
             }
             if self.flips >= limit {
@@ -335,6 +339,37 @@ impl IntrinsicTriangulation {
     }
 }
 
+/// `3 #F` halfedge lengths (`3 f + k`: corner `k` to `k + 1`) of `triangles` (`#F x 3`) on
+/// `positions` (`#V x 3`); fails on an out-of-range vertex.
+pub(super) fn halfedge_lengths(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+) -> Result<Vec<f64>, IntrinsicDelaunayError> {
+    let n_vertices = positions.len();
+    let mut length = Vec::with_capacity(3 * triangles.len());
+    for (face, t) in triangles.iter().enumerate() {
+        if let Some(&vertex) = t.iter().find(|&&v| v as usize >= n_vertices) {
+            return Err(IntrinsicDelaunayError::VertexOutOfRange { face, vertex, n_vertices });
+        }
+        length
+            .extend((0..3).map(|k| norm(sub(positions[t[(k + 1) % 3] as usize], positions[t[k] as usize]))));
+    }
+    Ok(length)
+}
+
+/// `3 #F` entries `(min, max, halfedge)`, one per halfedge of `triangles` keyed by its unordered
+/// vertex pair, sorted: the halfedges of one mesh edge are consecutive (deterministic, no hashing).
+pub(super) fn edge_groups(triangles: &[[u32; 3]]) -> Vec<(u32, u32, usize)> {
+    let mut keys: Vec<(u32, u32, usize)> = (0..3 * triangles.len())
+        .map(|h| {
+            let (a, b) = (triangles[h / 3][h % 3], triangles[h / 3][(h % 3 + 1) % 3]);
+            (a.min(b), a.max(b), h)
+        })
+        .collect();
+    keys.sort_unstable();
+    keys
+}
+
 /// Length of the diagonal `c - d` of the quad made by triangles `(a, b, c)` and `(b, a, d)` laid out
 /// flat on either side of `a - b` (SSC19 section 3.2: a 2D layout by the law of cosines).
 fn flipped_length(l_ab: f64, l_bc: f64, l_ca: f64, l_ad: f64, l_db: f64) -> f64 {
@@ -348,7 +383,7 @@ fn flipped_length(l_ab: f64, l_bc: f64, l_ca: f64, l_ad: f64, l_db: f64) -> f64 
 
 /// Area of the triangle with side lengths `l` (Heron, in the form of Kahan 2014 that is accurate for
 /// needle-like triangles); 0 if the lengths violate the triangle inequality.
-fn triangle_area(l: [f64; 3]) -> f64 {
+pub(super) fn triangle_area(l: [f64; 3]) -> f64 {
     let mut s = l;
     s.sort_by(|x, y| y.total_cmp(x)); // a >= b >= c
     let [a, b, c] = s;

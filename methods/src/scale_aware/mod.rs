@@ -33,7 +33,7 @@
 //!   count.
 //! - At least three constrained vertices are required (section 4, "at least three"); fewer leave
 //!   the similarity of `G` undetermined.
-//! - Weights (`weights`, default `intrinsic_delaunay`): the only Laplacian of the method is that of
+//! - Weights (`weights`, default `tufted_delaunay`): the only Laplacian of the method is that of
 //!   the section 5.2 initialization (linear Laplacian editing), so the weights enter the initial
 //!   guess only. Algorithm 1 itself has no cotangent Laplacian: step two's `G(Theta, N)` is built
 //!   from corner angles, and step one's normal-pyramid weights are face areas ([`gauss_map`]).

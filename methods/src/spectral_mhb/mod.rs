@@ -12,9 +12,9 @@
 //!    transfer (default) or local frames.
 //!
 //! Decisions the paper leaves open (tested in `tests/spectral_mhb.rs`):
-//! - Weights (`weights`, default `intrinsic_delaunay`): `L_s` of the bases (eq 5), of the energy
+//! - Weights (`weights`, default `tufted_delaunay`): `L_s` of the bases (eq 5), of the energy
 //!   (eq 13) and of the deformation-transfer Poisson system, and with it the masses `D` and `M`, which
-//!   for `intrinsic_delaunay` are the intrinsic triangles' ([`crate::operators::lumped_mass_for`]).
+//!   for `intrinsic_delaunay` and `tufted_delaunay` are the intrinsic triangles' ([`crate::operators::lumped_mass_for`]).
 //!   Not the deformation-transfer Poisson system: its right-hand side is built from gradients on
 //!   the mesh's triangles, and `G^T A G` of those is exactly the mesh's cotangent `-L`, which keeps
 //!   the rest shape a fixed point of the detail transfer; it always uses `cotan`.
