@@ -12,6 +12,7 @@
 //! report/                        the files people read, from records: tables, plots, pictures, page
 //! comparison                     two stored runs compared, case by case
 //! suite                          load a run's inputs, schedule its cases (jobs, shards), merge parts
+//! labelled                       the labelled verdict set: results of known truth judged by the rules
 //! case, self_intersection        run one case through its phases; open3d's check of a result
 //! stored_report, regression, pareto   records on disk (results.json), the gate, the fronts
 //! record, provenance             the run's record: what each case measured; where and how it ran
