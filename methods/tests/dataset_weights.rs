@@ -18,10 +18,10 @@ use methods::operators::{laplacian, LaplacianWeights};
 fn negatives(l: &SparseColMat<usize, f64>) -> (usize, usize) {
     let (s, v) = l.parts();
     let mut diagonal = vec![0.0f64; s.ncols()];
-    for j in 0..s.ncols() {
+    for (j, d) in diagonal.iter_mut().enumerate() {
         for idx in s.col_range(j) {
             if s.row_idx()[idx] == j {
-                diagonal[j] = v[idx].abs();
+                *d = v[idx].abs();
             }
         }
     }
@@ -72,7 +72,7 @@ fn measure(mesh: &meshes::TriMesh, weights: LaplacianWeights) -> Row {
             .map(|p| std::array::from_fn(|a| p[a] + amplitude * scale * rng()))
             .collect();
         let e = energy.relative_energy(&x);
-        negative += usize::from(!(e >= 0.0));
+        negative += usize::from(e.is_nan() || e < 0.0);
         least = least.min(e);
     }
     Ok((all, large, negative, least))
@@ -102,7 +102,7 @@ fn dataset_negative_weights_and_arap_energies() {
     );
     let mut totals = [[0usize; 4]; 2];
     for file in files {
-        let input = meshes::io::read_mesh(&dir.join(file)).unwrap();
+        let input = meshes::io::read_mesh(dir.join(file)).unwrap();
         let (mesh, _) = meshes::clean::drop_unreferenced(&input);
         let boundary = meshes::Topology::new(&mesh)
             .map(|t| t.boundary_loops().iter().map(Vec::len).sum::<usize>().to_string())
