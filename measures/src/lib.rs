@@ -88,23 +88,48 @@ pub fn evaluate<H: AsRef<[usize]>, T: AsRef<[[f64; 3]]>>(
     targets: &[T],
     reference: Option<&[[f64; 3]]>,
 ) -> Result<Quality, MeasuresError> {
-    let triangles = faces
-        .iter()
-        .enumerate()
-        .map(|(f, t)| {
-            let whose = || format!("face {f}");
-            Ok([index(t[0], whose)?, index(t[1], whose)?, index(t[2], whose)?])
-        })
-        .collect::<Result<Vec<[u32; 3]>, MeasuresError>>()?;
-    let mesh = TriMesh::new(rest.to_vec(), triangles)?;
-    let topology = Topology::new(&mesh)?;
-    check_size("result", result.len(), rest.len())?;
-    if let Some(reference) = reference {
-        check_size("reference", reference.len(), rest.len())?;
+    let edit = Arrays::check(rest, faces, result, fixed, handles, targets, reference)?;
+    let geometry = RestGeometry::new(&edit.mesh, &edit.topology);
+    Ok(evaluate_on(&geometry, &edit.mesh, &edit.topology, result, (&edit.handles, &edit.targets), reference))
+}
+
+/// The arrays of [`evaluate`] and [`judge`], checked and made into a mesh and an edit.
+struct Arrays {
+    mesh: TriMesh,
+    topology: Topology,
+    handles: HandleSet,
+    targets: HandleTargets,
+}
+
+impl Arrays {
+    /// Check that the arrays fit together (see [`evaluate`]'s errors) and build the mesh, its edges
+    /// and the edit (`fixed` first, as the region `fixed`).
+    fn check<H: AsRef<[usize]>, T: AsRef<[[f64; 3]]>>(
+        rest: &[[f64; 3]],
+        faces: &[[usize; 3]],
+        result: &[[f64; 3]],
+        fixed: &[usize],
+        handles: &[H],
+        targets: &[T],
+        reference: Option<&[[f64; 3]]>,
+    ) -> Result<Arrays, MeasuresError> {
+        let triangles = faces
+            .iter()
+            .enumerate()
+            .map(|(f, t)| {
+                let whose = || format!("face {f}");
+                Ok([index(t[0], whose)?, index(t[1], whose)?, index(t[2], whose)?])
+            })
+            .collect::<Result<Vec<[u32; 3]>, MeasuresError>>()?;
+        let mesh = TriMesh::new(rest.to_vec(), triangles)?;
+        let topology = Topology::new(&mesh)?;
+        check_size("result", result.len(), rest.len())?;
+        if let Some(reference) = reference {
+            check_size("reference", reference.len(), rest.len())?;
+        }
+        let (handles, targets) = edit(rest, fixed, handles, targets)?;
+        Ok(Arrays { mesh, topology, handles, targets })
     }
-    let (handles, targets) = edit(rest, fixed, handles, targets)?;
-    let geometry = RestGeometry::new(&mesh, &topology);
-    Ok(evaluate_on(&geometry, &mesh, &topology, result, (&handles, &targets), reference))
 }
 
 /// [`evaluate`] for a caller that measures many results on one rest mesh (the harness: every
@@ -162,28 +187,15 @@ pub fn judge<H: AsRef<[usize]>, T: AsRef<[[f64; 3]]>>(
     targets: &[T],
     reference: Option<&[[f64; 3]]>,
 ) -> Result<Judgement, MeasuresError> {
-    let triangles = faces
-        .iter()
-        .enumerate()
-        .map(|(f, t)| {
-            let whose = || format!("face {f}");
-            Ok([index(t[0], whose)?, index(t[1], whose)?, index(t[2], whose)?])
-        })
-        .collect::<Result<Vec<[u32; 3]>, MeasuresError>>()?;
-    let mesh = TriMesh::new(rest.to_vec(), triangles)?;
-    let topology = Topology::new(&mesh)?;
-    check_size("result", result.len(), rest.len())?;
-    if let Some(reference) = reference {
-        check_size("reference", reference.len(), rest.len())?;
-    }
-    let (handles, targets) = edit(rest, fixed, handles, targets)?;
-    let geometry = RestGeometry::new(&mesh, &topology);
+    let edit = Arrays::check(rest, faces, result, fixed, handles, targets, reference)?;
+    let geometry = RestGeometry::new(&edit.mesh, &edit.topology);
     let reference = match reference {
         Some(r) if r == result => Reference::Itself,
         Some(positions) => Reference::Of { positions, finished: true },
         None => Reference::Missing,
     };
-    Ok(judge_on(rules, &geometry, &mesh, &topology, result, &[(&handles, &targets)], reference))
+    let steps = [(&edit.handles, &edit.targets)];
+    Ok(judge_on(rules, &geometry, &edit.mesh, &edit.topology, result, &steps, reference))
 }
 
 /// [`judge`] for a caller that judges many results on one rest mesh (the harness), as

@@ -1,5 +1,5 @@
 //! How far the surface turned: one-rings and regions fitted by their closest rotation (Kabsch), the
-//! turn the handles ask ([`asked_turn`]) and the scale they ask ([`asked_scale`]), a result's turn
+//! turn the handles ask ([`asked_turn`]; the size they ask is [`crate::size`]'s), a result's turn
 //! beyond what they ask and its turn against a reference result.
 
 use meshes::vector::{norm, sub};
@@ -201,31 +201,6 @@ pub fn asked_turn(rest: &[[f64; 3]], handles: &HandleSet, targets: &HandleTarget
     rotation + bend
 }
 
-/// The scale the handles ask: the RMS distance of the constrained vertices' targets from their
-/// centroid over that of their rest positions (`rest`: `#V x 3`). 1 for any rigid motion of all
-/// handles together and for regions each turned about its own centroid (the dataset's bend and
-/// twist); above 1 where regions are pulled apart (a stretch), below where they are pushed together.
-/// 1 when the handles have no spread (fewer than two distinct constrained vertices).
-pub fn asked_scale(rest: &[[f64; 3]], handles: &HandleSet, targets: &HandleTargets) -> f64 {
-    let pairs: Vec<([f64; 3], [f64; 3])> =
-        handles.constrained().zip(targets.positions()).map(|(v, t)| (rest[v as usize], *t)).collect();
-    let n = pairs.len() as f64;
-    let (mut c0, mut c1) = ([0.0; 3], [0.0; 3]);
-    for (p, t) in &pairs {
-        for a in 0..3 {
-            c0[a] += p[a] / n;
-            c1[a] += t[a] / n;
-        }
-    }
-    let spread0: f64 = pairs.iter().map(|(p, _)| norm(sub(*p, c0)).powi(2)).sum();
-    let spread1: f64 = pairs.iter().map(|(_, t)| norm(sub(*t, c1)).powi(2)).sum();
-    if spread0 > 0.0 && spread1.is_finite() {
-        (spread1 / spread0).sqrt()
-    } else {
-        1.0
-    }
-}
-
 /// Per vertex, the angle (radians) of the rotation closest to
 /// `sum_j (x_i - x_j)(x0_i - x0_j)^T` over its one-ring: how far its neighbourhood turned from
 /// `rest` to `result` (both `#V x 3`). An isolated vertex turns 0.
@@ -321,48 +296,6 @@ mod tests {
 
     /// The bar's two end regions: 1 when the top turns about its own centroid (a bend or twist
     /// asks no size), `s` when every target is scaled by `s`, and above 1 when the ends move apart.
-    #[test]
-    fn the_asked_scale_is_the_spread_of_the_targets() {
-        let (mesh, _, _) = shape(ShapeKind::Bar);
-        let p = mesh.positions();
-        let (lo, hi) = mesh.bbox();
-        let height = hi[2] - lo[2];
-        let region = |name: &str, keep: &dyn Fn(f64) -> bool| methods::HandleRegion {
-            name: name.into(),
-            vertices: (0..p.len() as u32).filter(|&v| keep(p[v as usize][2])).collect(),
-        };
-        let handles = HandleSet::new(
-            vec![
-                region("bottom", &|z| z < lo[2] + 0.1 * height),
-                region("top", &|z| z > lo[2] + 0.9 * height),
-            ],
-            p.len(),
-        )
-        .unwrap();
-        let top = handles.region_of();
-        let scale_of = |f: &dyn Fn([f64; 3], bool) -> [f64; 3]| {
-            let targets = HandleTargets::new(
-                &handles,
-                handles.constrained().map(|v| f(p[v as usize], top[v as usize] == 1)).collect(),
-            )
-            .unwrap();
-            asked_scale(p, &handles, &targets)
-        };
-        let n = handles.regions()[1].vertices.len() as f64;
-        let mut c = [0.0; 3];
-        for &v in &handles.regions()[1].vertices {
-            for a in 0..3 {
-                c[a] += p[v as usize][a] / n;
-            }
-        }
-        let twist = AffineTransform::rotation_about([0.0, 0.0, 1.0], 1.2, c);
-        let turned = scale_of(&|x, is_top| if is_top { twist.apply(x) } else { x });
-        assert!((turned - 1.0).abs() < 1e-12, "{turned}");
-        let scaled = scale_of(&|x, _| [1.3 * x[0] + 2.0, 1.3 * x[1], 1.3 * x[2]]);
-        assert!((scaled - 1.3).abs() < 1e-12, "{scaled}");
-        let stretched = scale_of(&|x, is_top| if is_top { [x[0], x[1], x[2] + 0.25 * height] } else { x });
-        assert!(stretched > 1.15 && stretched < 1.3, "{stretched}");
-    }
 
     /// Against a reference: 0 for the reference itself and for both turned by one rigid motion; a
     /// part turned on its own shows its turn once it holds more than half of the free surface.
@@ -448,5 +381,35 @@ mod tests {
         let from_held = asked_turn(p, &handles, &targets, Bends::FromHeld).to_degrees();
         assert!(all > 90.0, "pulled apart across a gap of 0.2: {all}");
         assert!(from_held > 0.0 && from_held < 20.0, "from the base far below: {from_held}");
+    }
+
+    /// Issue 62: two regions turned together as one rigid body ask their turn and no bend; one of
+    /// them moved away besides asks a bend.
+    #[test]
+    fn a_rigid_motion_of_all_handles_asks_its_turn_and_no_bend() {
+        let rest: Vec<[f64; 3]> = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [10.0, 0.0, 0.0],
+            [11.0, 0.0, 0.0],
+            [10.0, 1.0, 0.0],
+        ];
+        let region =
+            |name: &str, v: &[u32]| methods::HandleRegion { name: name.into(), vertices: v.to_vec() };
+        let handles =
+            HandleSet::new(vec![region("a", &[0, 1, 2]), region("b", &[3, 4, 5])], rest.len()).unwrap();
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let turned = |p: [f64; 3]| [c * p[0] - s * p[1] + 2.0, s * p[0] + c * p[1] - 1.0, p[2] + 3.0];
+        let targets = HandleTargets::new(&handles, rest.iter().map(|p| turned(*p)).collect()).unwrap();
+        let asked = asked_turn(&rest, &handles, &targets, Bends::All).to_degrees();
+        assert!((asked - 30.0).abs() < 1e-9, "{asked}");
+        let apart: Vec<[f64; 3]> = rest
+            .iter()
+            .enumerate()
+            .map(|(v, p)| if v < 3 { turned(*p) } else { turned([p[0] + 2.0, p[1], p[2]]) })
+            .collect();
+        let targets = HandleTargets::new(&handles, apart).unwrap();
+        assert!(asked_turn(&rest, &handles, &targets, Bends::All).to_degrees() > 40.0);
     }
 }
