@@ -96,9 +96,18 @@ fn all_on_survey_data_writes_reports_that_meet_the_acceptance_figures() {
         }
         let arap = rows.iter().find(|r| r["scenario"] == scenario && r["method"] == "arap").unwrap();
         assert_eq!(support::num(arap, "rms_to_arap_over_diag"), 0.0);
-        // The isoline model reaches its hard handles, does not fold and stays in its frame.
+        // The isoline model reaches its hard handles, does not fold and stays in its frame; on the
+        // cylinder its bend loses 27% of the area, which the size verdict sees (issue 62).
         let isolines = rows.iter().find(|r| r["scenario"] == scenario && r["method"] == "isolines").unwrap();
-        assert_eq!(isolines["status"], "ok", "{scenario}/isolines");
+        if scenario == "cylinder" {
+            assert!(
+                isolines["status"].starts_with("suspect: shrinks: its surface area fell"),
+                "{}",
+                isolines["status"]
+            );
+        } else {
+            assert_eq!(isolines["status"], "ok", "{scenario}/isolines");
+        }
     }
     // Issue 14: what the angles hide. The survey bar is open (no volume); the scale-aware balloon on it
     // shows in e_area, many times arap's.

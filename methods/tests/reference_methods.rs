@@ -182,9 +182,14 @@ fn anderson_arap_reaches_the_plain_fixed_point_in_fewer_iterations() {
     let bar = bar();
     let (mesh, handles) = (&bar.mesh, bar.handles());
     let targets = bar.handle_moved_by(&handles, &bar.edit);
+    // Weights pinned (issue 62): on this twist ARAP has more than one fixed point, and which one
+    // the plain iteration falls into turns on rounding. With the tufted weights, equal to these to
+    // 1e-16 on this closed bar, the plain iterates end 0.11 diagonals from Anderson's after 12,000
+    // iterations: another minimum, not a slower path to the same one. What this test checks is the
+    // acceleration to one fixed point, so it keeps the weights under which both reach the same.
     let run = |acceleration: &str, iterations: usize, tolerance: f64| {
         let text = format!(
-            "solver = \"local_global\"\nmax_iterations = {iterations}\ntolerance = {tolerance:e}\nacceleration = \"{acceleration}\"\nstart = \"current\""
+            "solver = \"local_global\"\nmax_iterations = {iterations}\ntolerance = {tolerance:e}\nacceleration = \"{acceleration}\"\nstart = \"current\"\nweights = \"intrinsic_delaunay\""
         );
         let mut arap = create("arap", &params(&text)).unwrap();
         arap.precompute(mesh).unwrap();
