@@ -323,7 +323,7 @@ pub const METRICS: [MetricSpec; 17] = [
         label: "E_arap",
         unit: "",
         doc:
-            "the ARAP energy of the result (SA07 eq 3, intrinsic Delaunay spokes, the rotations of its local \
+            "the ARAP energy of the result (SA07 eq 3, tufted intrinsic Delaunay spokes, the rotations of its local \
               step), over the rest shape's Dirichlet energy sum w |p_i − p_j|²: what the reference `arap` \
               minimizes; a method below the reference found a lower local minimum (index.html says so)",
         better: Better::Lower,
