@@ -8,6 +8,9 @@
 //!
 //! `DEFORM_DATASET_DIR=... cargo test --release -p methods --test dataset_weights -- --ignored --nocapture`
 
+mod support;
+use support::noise;
+
 use faer::sparse::SparseColMat;
 use methods::arap::ArapEnergy;
 use methods::operators::{laplacian, LaplacianWeights};
@@ -36,19 +39,6 @@ fn negatives(l: &SparseColMat<usize, f64>) -> (usize, usize) {
         }
     }
     (all, large)
-}
-
-/// Deterministic pseudo-random numbers in `[-1, 1)` (splitmix64).
-fn noise(seed: u64) -> impl FnMut() -> f64 {
-    let mut state = seed;
-    move || {
-        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
 }
 
 /// Per weight: `(negative weights, of them below -1e-12 x the local diagonal, negative energies of

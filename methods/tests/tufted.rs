@@ -4,6 +4,9 @@
 //! on a closed Delaunay mesh and `intrinsic_delaunay` on closed meshes, defined on a non-manifold
 //! fan, mollified degenerate faces, and an ARAP energy that is never negative on open meshes.
 
+mod support;
+use support::{dense, entries, noise};
+
 use faer::sparse::SparseColMat;
 use meshes::shapes::{generate, ShapeKind};
 use meshes::TriMesh;
@@ -12,20 +15,6 @@ use methods::operators::{
     cotan_laplacian, laplacian, lumped_mass_for, IntrinsicDelaunayError, LaplacianWeights, MassKind,
     TuftedDelaunay, MOLLIFY_FACTOR,
 };
-
-/// `(i, j, value)` of every stored entry.
-fn entries(l: &SparseColMat<usize, f64>) -> Vec<(usize, usize, f64)> {
-    let (s, v) = l.parts();
-    (0..s.ncols()).flat_map(|j| s.col_range(j).map(move |idx| (s.row_idx()[idx], j, v[idx]))).collect()
-}
-
-fn dense(l: &SparseColMat<usize, f64>) -> Vec<Vec<f64>> {
-    let mut d = vec![vec![0.0; l.ncols()]; l.nrows()];
-    for (i, j, v) in entries(l) {
-        d[i][j] += v;
-    }
-    d
-}
 
 /// Number of negative off-diagonal entries (negative weights).
 fn negative_weights(l: &SparseColMat<usize, f64>) -> usize {
@@ -201,19 +190,6 @@ fn degenerate_faces_are_mollified() {
     // A face that repeats a vertex is an error, not a panic.
     assert!(TuftedDelaunay::new(&p, &[[0, 0, 1]], MOLLIFY_FACTOR).is_err());
     assert!(TuftedDelaunay::new(&p, &[[0, 1, 7]], MOLLIFY_FACTOR).is_err());
-}
-
-/// Deterministic pseudo-random numbers in `[-1, 1)` (splitmix64).
-fn noise(seed: u64) -> impl FnMut() -> f64 {
-    let mut state = seed;
-    move || {
-        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
 }
 
 #[test]

@@ -3,6 +3,9 @@
 //! clamped weights, ARAP's rest-shape fixed point for every choice, and an obtuse sliver band where
 //! cotangent ARAP folds and the default does not.
 
+mod support;
+use support::{dense, entries};
+
 use faer::sparse::SparseColMat;
 use meshes::shapes::{generate, ShapeKind};
 use meshes::vector::{cross, dot, norm, normalize_or_zero, sub};
@@ -28,20 +31,6 @@ fn name(w: LaplacianWeights) -> &'static str {
         LaplacianWeights::IntrinsicDelaunay => "intrinsic_delaunay",
         LaplacianWeights::TuftedDelaunay => "tufted_delaunay",
     }
-}
-
-/// `(i, j, value)` of every stored entry.
-fn entries(l: &SparseColMat<usize, f64>) -> Vec<(usize, usize, f64)> {
-    let (s, v) = l.parts();
-    (0..s.ncols()).flat_map(|j| s.col_range(j).map(move |idx| (s.row_idx()[idx], j, v[idx]))).collect()
-}
-
-fn dense(l: &SparseColMat<usize, f64>) -> Vec<Vec<f64>> {
-    let mut d = vec![vec![0.0; l.ncols()]; l.nrows()];
-    for (i, j, v) in entries(l) {
-        d[i][j] += v;
-    }
-    d
 }
 
 /// Smallest off-diagonal entry relative to the largest magnitude (project sign: off-diagonals are
