@@ -5,6 +5,8 @@ use methods::{HandleSet, HandleTargets};
 
 use crate::distortion::ResultAngles;
 use crate::rest::RestGeometry;
+use crate::size::face_stretches;
+use crate::turn::one_ring_turns;
 
 /// What a measure is computed from: one result on its scenario's rest mesh.
 pub struct Evaluation<'a> {
@@ -20,6 +22,13 @@ pub struct Evaluation<'a> {
     pub reference: Option<&'a [[f64; 3]]>,
     /// The result's corner and dihedral angles, computed once for every measure that needs them.
     pub angles: ResultAngles,
+    /// `#F` stretches of the result's faces ([`face_stretches`]), once for `e_iso` and the shares.
+    pub stretches: Vec<Option<[f64; 2]>>,
+    /// The same of the reference's faces, where there is a reference other than this result.
+    pub reference_stretches: Option<Vec<Option<[f64; 2]>>>,
+    /// `#V` turns of the result's one-rings ([`one_ring_turns`], radians), once for both turn
+    /// measures.
+    pub turns: Vec<f64>,
 }
 
 impl<'a> Evaluation<'a> {
@@ -34,6 +43,23 @@ impl<'a> Evaluation<'a> {
         reference: Option<&'a [[f64; 3]]>,
     ) -> Self {
         let angles = ResultAngles::new(mesh, topology, result);
-        Self { rest, mesh, topology, result, handles, targets, reference, angles }
+        let (p, t) = (mesh.positions(), mesh.triangles());
+        let stretches = face_stretches(p, result, t);
+        // A reference that is this very result (the reference judged itself) is none to compare with.
+        let reference_stretches = reference.filter(|r| *r != result).map(|r| face_stretches(p, r, t));
+        let turns = one_ring_turns(p, result, topology);
+        Self {
+            rest,
+            mesh,
+            topology,
+            result,
+            handles,
+            targets,
+            reference,
+            angles,
+            stretches,
+            reference_stretches,
+            turns,
+        }
     }
 }

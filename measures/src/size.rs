@@ -169,9 +169,8 @@ pub fn face_stretches(
 /// Decision (issue 62): weighted by rest area, not a plain mean over faces, so the answer does not
 /// depend on how finely a region is meshed: real scans mix slivers and large faces.
 pub fn isometric_distortion(e: &Evaluation) -> f64 {
-    let stretches = face_stretches(e.mesh.positions(), e.result, e.mesh.triangles());
     let (mut sum, mut weight) = (0.0, 0.0);
-    for (s, a0) in stretches.iter().zip(&e.rest.areas) {
+    for (s, a0) in e.stretches.iter().zip(&e.rest.areas) {
         if let Some([large, small]) = s {
             let (l1, l2) = (large.ln(), if *small > 0.0 { small.ln() } else { f64::NEG_INFINITY });
             sum += a0 * 0.5 * (l1 * l1 + l2 * l2);
@@ -199,12 +198,8 @@ pub const LOCAL_AREA_MARGIN: f64 = 1.5;
 /// face's factor in the reference result if there is one, by more than [`LOCAL_AREA_MARGIN`] below
 /// or above. A patch shrunk or swollen on its own is seen even when the total area is not.
 pub fn resized_shares(e: &Evaluation) -> (f64, f64) {
-    let rest = e.mesh.positions();
-    let triangles = e.mesh.triangles();
-    let asked = asked_size(rest, e.handles, e.targets);
-    let ours = face_stretches(rest, e.result, triangles);
-    // A reference that is this very result (the reference judged itself) widens nothing.
-    let theirs = e.reference.filter(|r| *r != e.result).map(|r| face_stretches(rest, r, triangles));
+    let asked = asked_size(e.mesh.positions(), e.handles, e.targets);
+    let (ours, theirs) = (&e.stretches, &e.reference_stretches);
     let margin = LOCAL_AREA_MARGIN.ln();
     let (mut shrunk, mut swollen, mut total) = (0.0, 0.0, 0.0);
     for (f, (s, a0)) in ours.iter().zip(&e.rest.areas).enumerate() {

@@ -20,9 +20,9 @@ pub const TURN_PERCENTILE: f64 = 0.9;
 /// unconverged isolines iterates turned the armadillo's torso by 91-96 deg for a hand turned 30.
 pub fn turn_beyond_handles(e: &Evaluation) -> f64 {
     let rest = e.mesh.positions();
-    let turns = one_ring_turns(rest, e.result, e.topology);
     let region_of = e.handles.region_of();
-    let free: Vec<f64> = turns
+    let free: Vec<f64> = e
+        .turns
         .iter()
         .enumerate()
         .filter(|(v, _)| region_of[*v] == methods::handles::FREE)
@@ -45,7 +45,6 @@ pub const TURNED_MARGIN_DEG: f64 = 45.0;
 /// share so that a few noisy one-rings do not count.
 pub fn turned_share(e: &Evaluation) -> f64 {
     let rest = e.mesh.positions();
-    let turns = one_ring_turns(rest, e.result, e.topology);
     let region_of = e.handles.region_of();
     let limit = asked_turn(rest, e.handles, e.targets, Bends::All) + TURNED_MARGIN_DEG.to_radians();
     let mut vertex_area = vec![0.0; rest.len()];
@@ -55,7 +54,7 @@ pub fn turned_share(e: &Evaluation) -> f64 {
         }
     }
     let (mut turned, mut free) = (0.0, 0.0);
-    for (v, turn) in turns.iter().enumerate() {
+    for (v, turn) in e.turns.iter().enumerate() {
         if region_of[v] == methods::handles::FREE {
             free += vertex_area[v];
             if *turn > limit {
