@@ -4,8 +4,10 @@
 //! database or process library, so a Python package or a user's program can use it alone.
 //!
 //! [`evaluate`] is the entry point: plain arrays in (rest and result positions, faces, handle
-//! regions and their targets), every measure out. The harness measures every case through
-//! [`evaluate_on`], the same function with the rest side computed once per scenario.
+//! regions and their targets), every measure out; [`judge`] takes the same arrays and the verdict
+//! rules and gives the measures with the reasons a result is suspect. The harness measures and
+//! judges every case through [`judge_on`] (over [`evaluate_on`]), the same with the rest side
+//! computed once per scenario.
 //!
 //! The modules, by concept:
 //!
@@ -14,8 +16,9 @@
 //! - [`quality`]: [`Quality`], the values of one result, and its results.json form;
 //! - [`rest`], [`evaluation`]: what the measures compare with (once per rest mesh) and what they
 //!   read of one result;
-//! - [`distortion`], [`turn`], [`distance`]: the measures themselves (angles, areas, lengths,
-//!   volume, folds; turns of the surface and the turn and scale the handles ask; distances);
+//! - [`distortion`], [`turn`], [`size`], [`distance`]: the measures themselves (angles, areas,
+//!   lengths, volume, folds; turns of the surface and the turn the handles ask; the size they ask,
+//!   face stretches, e_iso and the resized shares; distances);
 //! - [`statistics`]: RMS and percentiles;
 //! - [`verdict`], [`status`], [`step_trend`]: the rules that make a case `suspect`, the status they
 //!   give, and why an iteration did not finish;

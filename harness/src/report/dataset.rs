@@ -114,10 +114,15 @@ pub fn ranks(cases: &[&CaseResult]) -> BTreeMap<(String, String), usize> {
     out
 }
 
-/// Per method of `methods`, how many of its cases in `family` (all: `None`) have no rank, and why:
-/// `scale_aware 7 (suspect 6: swells 4, shrinks 2; unfinished 1)`; `None` when every case is ranked.
-pub fn unranked(cases: &[&CaseResult], methods: &[&str], family: Option<&str>) -> Option<String> {
-    let ranks = ranks(cases);
+/// Per method of `methods`, how many of its cases in `family` (all: `None`) have no rank in `ranks`
+/// ([`ranks`] of `cases`), and why: `scale_aware 7 (suspect 6: swells 4, shrinks 2; unfinished 1)`;
+/// `None` when every case is ranked.
+pub fn unranked(
+    cases: &[&CaseResult],
+    methods: &[&str],
+    family: Option<&str>,
+    ranks: &BTreeMap<(String, String), usize>,
+) -> Option<String> {
     let mut parts = Vec::new();
     for m in methods {
         let left: Vec<&CaseResult> = (cases.iter().copied())
@@ -301,7 +306,7 @@ fn error_spread_cost_and_rank(document: &mut Document, cases: &[&CaseResult], me
     for family in families(cases).into_iter().map(Some).chain([None]) {
         document.heading(3, family.unwrap_or("all families"));
         document.table(spread_table(cases, methods, family, &ranks));
-        if let Some(note) = unranked(cases, methods, family) {
+        if let Some(note) = unranked(cases, methods, family, &ranks) {
             document.paragraph(note);
         }
     }
@@ -481,10 +486,10 @@ mod tests {
         );
         let methods = methods_of(&refs);
         assert_eq!(
-            unranked(&refs, &methods, None).unwrap(),
+            unranked(&refs, &methods, None, &r).unwrap(),
             "Not ranked: hirm 1 (suspect 1: folds 1); isolines 1 (unfinished 1); spectral_mhb 1 (failed 1)."
         );
-        assert_eq!(unranked(&refs[..2], &methods, Some("twist")), None);
+        assert_eq!(unranked(&refs[..2], &methods, Some("twist"), &r), None);
     }
 
     #[test]
