@@ -4,9 +4,8 @@ use meshes::{Topology, TriMesh};
 use methods::{HandleSet, HandleTargets};
 
 use crate::distortion::ResultAngles;
+use crate::local::{face_stretches, one_ring_turns};
 use crate::rest::RestGeometry;
-use crate::size::face_stretches;
-use crate::turn::one_ring_turns;
 
 /// What a measure is computed from: one result on its scenario's rest mesh.
 pub struct Evaluation<'a> {

@@ -14,8 +14,8 @@
 //! - [`metric`]: the metric table ([`METRICS`]): each measure's key, unit, formula, which way is
 //!   better, regression tolerance, print format and function;
 //! - [`quality`]: [`Quality`], the values of one result, and its results.json form;
-//! - [`rest`], [`evaluation`]: what the measures compare with (once per rest mesh) and what they
-//!   read of one result;
+//! - [`rest`], [`evaluation`], [`local`]: what the measures compare with (once per rest mesh), what
+//!   they read of one result, and what each of its faces and one-rings did;
 //! - [`distortion`], [`turn`], [`size`], [`distance`]: the measures themselves (angles, areas,
 //!   lengths, volume, folds; turns of the surface and the turn the handles ask; the size they ask,
 //!   face stretches, e_iso and the resized shares; distances);
@@ -33,6 +33,7 @@ pub mod distance;
 pub mod distortion;
 pub mod error;
 pub mod evaluation;
+pub mod local;
 pub mod metric;
 pub mod quality;
 pub mod rest;

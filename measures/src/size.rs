@@ -8,10 +8,11 @@
 //! that lost a third of their area were `ok`; and they read only the total area, so a patch shrunk
 //! or swollen while the total held was never seen.
 
-use meshes::vector::{cross, dot, norm, sub};
+use meshes::vector::{norm, sub};
 use methods::{HandleSet, HandleTargets};
 
 use crate::evaluation::Evaluation;
+pub use crate::local::face_stretches;
 
 /// The range of area factors (`A / A⁰`) the handles ask of the surface. Decision (issue 62), per
 /// handle region from its own motion:
@@ -119,45 +120,6 @@ fn centroids(pairs: &[([f64; 3], [f64; 3])]) -> ([f64; 3], [f64; 3]) {
         }
     }
     (c0, c1)
-}
-
-/// Per face of `triangles` (`#F x 3`), the singular values `[σ_max, σ_min]` of the deformation
-/// gradient that maps its `rest` triangle onto its `result` triangle (both `#V x 3`): the largest
-/// and smallest factor by which it stretched a direction in its plane. `σ_max σ_min` is its area
-/// factor; both are 1 for a rigid motion and `s` for a uniform scaling by `s`. `None` for a rest
-/// face of zero area (it has no plane).
-pub fn face_stretches(
-    rest: &[[f64; 3]],
-    result: &[[f64; 3]],
-    triangles: &[[u32; 3]],
-) -> Vec<Option<[f64; 2]>> {
-    triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|v| v as usize);
-            let (e1, e2) = (sub(rest[b], rest[a]), sub(rest[c], rest[a]));
-            let (f1, f2) = (sub(result[b], result[a]), sub(result[c], result[a]));
-            // The rest triangle in an orthonormal frame of its plane: R = [[x1, x2], [0, y2]].
-            let x1 = norm(e1);
-            let twice_area = norm(cross(e1, e2));
-            if !(x1 > 0.0 && twice_area > 0.0) {
-                return None;
-            }
-            let x2 = dot(e1, e2) / x1;
-            let y2 = twice_area / x1;
-            // J = F R⁻¹ with R⁻¹ = [[1/x1, -x2/(x1 y2)], [0, 1/y2]]; its columns:
-            let j1 = f1.map(|v| v / x1);
-            let j2: [f64; 3] = std::array::from_fn(|k| (f2[k] - f1[k] * x2 / x1) / y2);
-            // Singular values from JᵀJ = [[p, q], [q, r]].
-            let (p, q, r) = (dot(j1, j1), dot(j1, j2), dot(j2, j2));
-            let half_trace = 0.5 * (p + r);
-            let root = (0.25 * (p - r) * (p - r) + q * q).sqrt();
-            let largest = (half_trace + root).sqrt();
-            // σ_min from the determinant, which keeps its digits where σ_min ≪ σ_max.
-            let smallest = if largest > 0.0 { norm(cross(j1, j2)) / largest } else { 0.0 };
-            Some([largest, smallest])
-        })
-        .collect()
 }
 
 /// Isometric distortion of `e.result`: `sqrt( Σ_f A⁰_f (ln² σ_max + ln² σ_min) / 2 / Σ_f A⁰_f )`,

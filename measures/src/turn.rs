@@ -3,11 +3,11 @@
 //! beyond what they ask and its turn against a reference result.
 
 use meshes::vector::{norm, sub};
-use meshes::Topology;
 use methods::rotation_fit::{closest_rotation, cross_covariance, rotation_angle};
 use methods::{HandleSet, HandleTargets};
 
 use crate::evaluation::Evaluation;
+pub use crate::local::one_ring_turns;
 use crate::statistics::percentile;
 
 /// Fraction of the free vertices whose turn [`turn_beyond_handles`] reads: its 90th percentile, so a
@@ -200,23 +200,6 @@ pub fn asked_turn(rest: &[[f64; 3]], handles: &HandleSet, targets: &HandleTarget
     rotation + bend
 }
 
-/// Per vertex, the angle (radians) of the rotation closest to
-/// `sum_j (x_i - x_j)(x0_i - x0_j)^T` over its one-ring: how far its neighbourhood turned from
-/// `rest` to `result` (both `#V x 3`). An isolated vertex turns 0.
-pub fn one_ring_turns(rest: &[[f64; 3]], result: &[[f64; 3]], topology: &Topology) -> Vec<f64> {
-    (0..rest.len())
-        .map(|i| {
-            let ring = topology.one_ring(i);
-            if ring.is_empty() {
-                return 0.0;
-            }
-            let pairs =
-                ring.iter().map(|&j| (sub(rest[i], rest[j as usize]), sub(result[i], result[j as usize])));
-            turn_of(&cross_covariance(pairs))
-        })
-        .collect()
-}
-
 /// The angle (radians) of the rotation that best maps the `(rest, target)` point pairs of one
 /// region (Kabsch, about their centroids); 0 for fewer than two points.
 pub fn region_turn(pairs: &[([f64; 3], [f64; 3])]) -> f64 {
@@ -247,11 +230,6 @@ pub fn region_rotation(pairs: &[([f64; 3], [f64; 3])]) -> [[f64; 3]; 3] {
 /// `r v`.
 fn rotate(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
     std::array::from_fn(|a| r[a][0] * v[0] + r[a][1] * v[1] + r[a][2] * v[2])
-}
-
-/// The angle (radians, in `[0, pi]`) of the rotation closest to the cross-covariance `m`.
-fn turn_of(m: &[[f64; 3]; 3]) -> f64 {
-    rotation_angle(&closest_rotation(m))
 }
 
 #[cfg(test)]
