@@ -249,9 +249,10 @@ fn peers_run_beside_arap_and_land_near_it() {
     }
     // The same energy to the same distance bound: the same stationary point up to the weights
     // (ours are the intrinsic Delaunay cotangents) and libigl's single-precision rotation fit, or a
-    // lower one. On this bar the symmetric twist is a saddle of the energy (docs/results.md, issue
-    // 51): our L-BFGS converges to it, the plain local/global iteration leaves it after ~1000
-    // iterations for a buckled shape of lower energy. Then the page names libigl's lower energy.
+    // lower one. On this bar the symmetric twist is a saddle of the energy (docs/results.md, issues
+    // 51 and 63): our L-BFGS converges to it and its saddle test leaves it for the buckled minimum
+    // that libigl's plain local/global iteration finds. Should they still end apart, the page
+    // names libigl's where it is the lower energy.
     let libigl = row(&rows, "libigl_arap");
     assert_eq!(libigl["converged"], "true");
     let distance = support::num(libigl, "rms_to_arap_over_diag");

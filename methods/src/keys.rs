@@ -60,6 +60,11 @@ pub mod statistic {
     /// scale_aware's step two: numeric factorizations, and lagged steps with a held one.
     pub const REFACTORIZATIONS: &str = "refactorizations";
     pub const LAGGED_STEPS: &str = "lagged_steps";
+    /// arap's saddle test: the relative energies of the first answer and of the perturbed solve's,
+    /// and whether the latter is the result (1) or not (0).
+    pub const SADDLE_TEST_FIRST_ENERGY: &str = "saddle_test_first_energy";
+    pub const SADDLE_TEST_SECOND_ENERGY: &str = "saddle_test_second_energy";
+    pub const SADDLE_TEST_SECOND_KEPT: &str = "saddle_test_second_kept";
 }
 
 /// The registered method names, the one place they are spelled (re-exported by

@@ -46,8 +46,8 @@ fn solve(
     (summary, arap.positions())
 }
 
-/// ~1.5K vertices, the bar 3K: the 1.5K bar's twist has two minima the solvers split between
-/// (relative ARAP energy: L-BFGS 8.47e-3, local/global 7.42e-3, 9.5e-2 diagonals apart; the
+/// ~1.5K vertices, the bar 3K: the 1.5K bar's twist has a saddle the solvers split at without the
+/// saddle test (relative ARAP energy: L-BFGS 8.47e-3, local/global 7.42e-3, 9.5e-2 diagonals apart; the
 /// ratio of the 127.0 / 110.5 between the two starts); at 3K and at the survey's 6K they
 /// meet (4e-8 apart).
 fn vertices(kind: ShapeKind) -> usize {

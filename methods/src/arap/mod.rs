@@ -53,6 +53,7 @@
 //! one local step, one right-hand side assembly and one back-substitution of 3 columns.
 
 mod quasi_newton;
+pub mod saddle_test;
 mod transformation_propagation;
 
 use faer::sparse::SparseColMat;
@@ -97,6 +98,9 @@ pub struct ArapParams {
     pub lbfgs_memory: usize,
     /// Least scale `c` of L-BFGS's initial Hessian `c K` (in `(0, 1]`; see [`quasi_newton`]).
     pub lbfgs_scale_floor: f64,
+    /// Size, times the bounding-box diagonal, of the smooth perturbation of a converged answer that
+    /// a second solve starts from ([`saddle_test`]); 0: no saddle test.
+    pub saddle_perturbation: f64,
 }
 
 /// How an ARAP solve minimizes the energy.
@@ -130,6 +134,7 @@ impl ArapParams {
             .count_at_most("anderson_depth", self.anderson_depth, crate::linalg::anderson::MAX_DEPTH)
             .count_at_most("lbfgs_memory", self.lbfgs_memory, 64)
             .number_in_half_open("lbfgs_scale_floor", self.lbfgs_scale_floor, 0.0, 1.0)
+            .number_at_least("saddle_perturbation", self.saddle_perturbation, 0.0)
             .finish(crate::keys::method_name::ARAP)
     }
 }
@@ -146,6 +151,7 @@ impl Default for ArapParams {
             solver: ArapSolver::default(),
             lbfgs_memory: 8,
             lbfgs_scale_floor: 0.5,
+            saddle_perturbation: 1e-3,
         }
     }
 }
@@ -181,6 +187,10 @@ pub struct Arap {
     next: Vec<[f64; 3]>,
     /// Per-vertex energies, summed in vertex order (deterministic).
     vertex_energies: Vec<f64>,
+    /// `sum w |e|^2` at rest, the scale of the relative energies the saddle test compares.
+    rest_dirichlet: f64,
+    /// The last solve's saddle test, if it ran.
+    saddle_test: Option<saddle_test::SaddleTest>,
 }
 
 impl Spokes {
@@ -260,6 +270,8 @@ impl Arap {
             image: Vec::new(),
             next: Vec::new(),
             vertex_energies: Vec::new(),
+            rest_dirichlet: 0.0,
+            saddle_test: None,
         })
     }
 
@@ -377,6 +389,8 @@ impl DeformationMethod for Arap {
         let stiffness = crate::operators::stiffness(laplacian);
         self.cholesky = Some(SparseCholesky::analyze(stiffness.as_ref())?);
         self.stiffness = Some(stiffness);
+        self.rest_dirichlet =
+            spokes.weights.iter().zip(&spokes.rest_edges).map(|(w, e)| w * meshes::vector::dot(*e, *e)).sum();
         self.spokes = Some(spokes);
         self.rest = rest.positions().to_vec();
         self.bbox_diagonal = rest.bbox_diagonal();
@@ -453,8 +467,88 @@ impl DeformationMethod for Arap {
             cholesky.solve_in_place(self.rhs.as_mut());
             move_to("arap", 0, &mut self.current, self.rhs.as_ref())?;
         }
-        let (tolerance, diagonal) = (self.params.tolerance, self.bbox_diagonal);
-        let iterations = Iterations { first: 0, count: self.params.max_iterations, tolerance };
+        let iterations =
+            Iterations { first: 0, count: self.params.max_iterations, tolerance: self.params.tolerance };
+        let first = self.minimize(iterations, observer)?;
+        self.saddle_test = None;
+        if self.params.saddle_perturbation > 0.0 && first.converged {
+            return self.test_for_saddle(first, observer);
+        }
+        Ok(first)
+    }
+
+    fn positions(&self) -> Vec<[f64; 3]> {
+        self.current.clone()
+    }
+
+    fn model_statistics(&self) -> Vec<(String, f64)> {
+        use crate::keys::statistic;
+        match self.saddle_test {
+            Some(t) => vec![
+                (statistic::SADDLE_TEST_FIRST_ENERGY.into(), t.first_energy),
+                (statistic::SADDLE_TEST_SECOND_ENERGY.into(), t.second_energy),
+                (statistic::SADDLE_TEST_SECOND_KEPT.into(), f64::from(u8::from(t.second_kept))),
+            ],
+            None => Vec::new(),
+        }
+    }
+}
+
+impl Arap {
+    /// The relative ARAP energy of `self.current` (local step included; rotations left in
+    /// `self.rotations`).
+    fn current_energy(&mut self) -> f64 {
+        let Some(spokes) = self.spokes.as_ref() else { return f64::NAN };
+        Self::local_step(spokes, &self.current, &mut self.rotations, &mut self.singular_frames);
+        Self::energy(spokes, &self.current, &self.rotations, &mut self.vertex_energies)
+            / self.rest_dirichlet.max(f64::MIN_POSITIVE)
+    }
+
+    /// The saddle test after the converged solve `first` ([`saddle_test`]): perturb, solve again,
+    /// keep the lower energy.
+    fn test_for_saddle(
+        &mut self,
+        first: SolveSummary,
+        observer: &mut dyn IterationObserver,
+    ) -> Result<SolveSummary, MethodError> {
+        let region_of = match &self.handles {
+            Some(h) => h.region_of().to_vec(),
+            None => return Ok(first),
+        };
+        let answer = self.current.clone();
+        let first_energy = self.current_energy();
+        let amplitude = self.params.saddle_perturbation * self.bbox_diagonal;
+        saddle_test::perturb(&mut self.current, &region_of, amplitude, self.bbox_diagonal);
+        let iterations = Iterations {
+            first: first.iterations,
+            count: self.params.max_iterations,
+            tolerance: self.params.tolerance,
+        };
+        let second = self.minimize(iterations, observer)?;
+        let second_energy = if second.converged { self.current_energy() } else { f64::INFINITY };
+        let outcome = saddle_test::SaddleTest::judge(first_energy, second_energy);
+        self.saddle_test = Some(outcome);
+        if outcome.second_kept {
+            return Ok(second);
+        }
+        self.current = answer;
+        self.current_energy();
+        Ok(SolveSummary { iterations: second.iterations, ..first })
+    }
+
+    /// Minimize from `self.current` with the configured solver until `iterations`' rule holds.
+    fn minimize(
+        &mut self,
+        iterations: Iterations,
+        observer: &mut dyn IterationObserver,
+    ) -> Result<SolveSummary, MethodError> {
+        let ((handles, spokes), cholesky) = require_phase(
+            self.handles.as_ref().zip(self.spokes.as_ref()).zip(self.cholesky.as_mut()),
+            "arap",
+            Phase::Solve,
+        )?;
+        let region_of = handles.region_of();
+        let diagonal = self.bbox_diagonal;
         if self.params.solver == ArapSolver::Lbfgs {
             let solver = quasi_newton::QuasiNewton {
                 spokes,
@@ -529,9 +623,5 @@ impl DeformationMethod for Arap {
             self.current.copy_from_slice(&self.image);
         }
         Ok(summary)
-    }
-
-    fn positions(&self) -> Vec<[f64; 3]> {
-        self.current.clone()
     }
 }
