@@ -1,0 +1,36 @@
+//! The configuration a Python program reads: the same as the command line's from the same
+//! directory (`./configs` when the current directory has one, else the copy built into the module;
+//! [`harness::paths::project_files`]), so that `Method("hirm", ...)` has the parameters
+//! `harness run --method hirm` has.
+
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+use harness::config::MethodCatalog;
+use measures::VerdictRules;
+
+use crate::errors::DeformbenchError;
+
+/// The configuration directory (`configs/`) of this process.
+fn configs_dir() -> Result<PathBuf, String> {
+    let files = harness::paths::project_files().map_err(|e| e.to_string())?;
+    Ok(files.root().join("configs"))
+}
+
+/// Every method of `configs/methods.toml` (built-in, variants, external), read once.
+pub fn catalog() -> pyo3::PyResult<&'static MethodCatalog> {
+    static CATALOG: OnceLock<Result<MethodCatalog, String>> = OnceLock::new();
+    CATALOG
+        .get_or_init(|| MethodCatalog::load(&configs_dir()?.join("methods.toml")).map_err(|e| e.to_string()))
+        .as_ref()
+        .map_err(|e| DeformbenchError::new_err(e.clone()))
+}
+
+/// The verdict rules of `configs/verdicts.toml`, read once.
+pub fn verdict_rules() -> pyo3::PyResult<&'static VerdictRules> {
+    static RULES: OnceLock<Result<VerdictRules, String>> = OnceLock::new();
+    RULES
+        .get_or_init(|| VerdictRules::load(&configs_dir()?.join("verdicts.toml")).map_err(|e| e.to_string()))
+        .as_ref()
+        .map_err(|e| DeformbenchError::new_err(e.clone()))
+}
