@@ -140,3 +140,35 @@ def verdict(
     ``{"status": "ok" | "suspect", "reasons": [str, ...], "measures": {...}}``. ``reference``
     (``arap``'s result on the same edit) widens the size verdicts by its own change, as on the page.
     """
+
+def run(
+    scenarios: Sequence[str],
+    methods: Sequence[Union[str, object, tuple[str, object]]],
+    reports: Optional[Union[str, PathLike]] = None,
+    survey_dir: Optional[Union[str, PathLike]] = None,
+    threads: Optional[int] = None,
+    repeat: int = 1,
+    mesh_format: str = "glb",
+) -> list[dict]:
+    """Run ``scenarios`` × ``methods`` through the harness's runner and write its reports
+    (``reports``, default ``./reports``: results.csv/json, index.html, figures), as
+    ``harness run --scenario ... --method ...``; returns the rows of ``results.json``.
+
+    Inputs:
+        scenarios: names of ``configs/scenarios/`` or scenario files.
+        methods: method names (``methods()``), and Python methods, judged, timed and reported like
+            an external method (``origin = "external"``): an object with the protocol's phases
+            ``precompute(V, F)``, ``bind(regions)``, ``solve(constrained, targets)`` (regions and
+            ``constrained`` 1-D int arrays, ``targets`` ``#b x 3``; docs/protocol.md), or a class
+            of them (one instance per case), or a function ``f(V, F, constrained, targets)``.
+            ``solve``/``f`` returns the ``#V x 3`` positions, or a dict with ``positions`` and
+            optionally ``iterations`` and ``converged``. Named by their ``name`` or ``__name__``,
+            or given as ``(name, object)``.
+        survey_dir: the survey data (default ``$DEFORM_SURVEY_DIR``; else procedural look-alikes).
+        threads: worker threads of every method (default: every core). Cases run one at a time.
+        repeat: repetitions of each case's timed phases.
+        mesh_format: result meshes as ``"glb"``, ``"off"`` or ``"both"``.
+    Raises:
+        DeformbenchError: a scenario or configuration error, a name taken. A Python method that
+        raises makes its case ``failed`` with the exception's type and message, not the run.
+    """

@@ -12,7 +12,7 @@ use measures::VerdictRules;
 use crate::errors::DeformbenchError;
 
 /// The configuration directory (`configs/`) of this process.
-fn configs_dir() -> Result<PathBuf, String> {
+pub fn configs_dir() -> Result<PathBuf, String> {
     let files = harness::paths::project_files().map_err(|e| e.to_string())?;
     Ok(files.root().join("configs"))
 }

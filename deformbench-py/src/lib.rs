@@ -9,6 +9,8 @@ mod configuration;
 mod errors;
 mod judgement;
 mod method;
+mod python_method;
+mod run;
 mod scenario;
 
 use pyo3::prelude::*;
@@ -24,5 +26,6 @@ fn deformbench(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(judgement::measure, m)?)?;
     m.add_function(wrap_pyfunction!(judgement::judge, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::load_scenario, m)?)?;
+    m.add_function(wrap_pyfunction!(run::run_suite, m)?)?;
     Ok(())
 }

@@ -368,6 +368,7 @@ impl Common {
             repetitions: self.repeat as usize,
             progress: !self.quiet,
             force: false,
+            provided: Vec::new(),
         })
     }
 }

@@ -78,6 +78,8 @@ pub enum Implementation {
     BuiltIn(&'static methods::registry::MethodEntry),
     /// A program over the protocol.
     External(ExternalEntry),
+    /// A method in this process, given by the program that runs the harness.
+    Provided(ProvidedMethod),
 }
 
 impl std::fmt::Debug for Implementation {
@@ -85,7 +87,25 @@ impl std::fmt::Debug for Implementation {
         match self {
             Implementation::BuiltIn(entry) => write!(f, "BuiltIn({})", entry.name),
             Implementation::External(e) => f.debug_tuple("External").field(e).finish(),
+            Implementation::Provided(p) => f.debug_tuple("Provided").field(p).finish(),
         }
+    }
+}
+
+/// A method a program hands the harness in its own process (the Python module's
+/// `deformbench.run(methods=[my_method])`): a fresh instance per case from `create`. Reported as
+/// an external method (not this suite's), without a process or a protocol.
+#[derive(Clone)]
+pub struct ProvidedMethod {
+    pub name: String,
+    /// One line: what it is (`list`, the page).
+    pub summary: String,
+    pub create: std::sync::Arc<dyn Fn() -> Result<Box<dyn DeformationMethod>, MethodError> + Send + Sync>,
+}
+
+impl std::fmt::Debug for ProvidedMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ProvidedMethod").field("name", &self.name).finish_non_exhaustive()
     }
 }
 
@@ -132,6 +152,7 @@ impl ConfiguredMethod {
         }
         match &self.implementation {
             Implementation::BuiltIn(entry) => (entry.create)(&self.params, solves),
+            Implementation::Provided(p) => (p.create)(),
             Implementation::External(e) => Ok(Box::new(ExternalMethod::start(ExternalSpec {
                 name: self.name.clone(),
                 program: e.program.clone(),
@@ -231,6 +252,33 @@ impl MethodCatalog {
             }
             self.add_entry(path, &name, &table, Origin::External, given, None)?;
         }
+        Ok(())
+    }
+
+    /// Add a method given in-process (`deformbench.run`); its name must be new.
+    pub fn add_provided(&mut self, provided: &ProvidedMethod) -> Result<(), HarnessError> {
+        if let Some(other) = self.get(&provided.name) {
+            let what = if other.file.as_os_str().is_empty() {
+                "a built-in method".to_string()
+            } else {
+                format!("an entry of {}", other.file.display())
+            };
+            return Err(HarnessError::Config {
+                path: PathBuf::from(&provided.name),
+                message: format!("`{}` is {what}; give the method another name", provided.name),
+            });
+        }
+        self.methods.push(ConfiguredMethod {
+            name: provided.name.clone(),
+            origin: Origin::External,
+            params: toml::Table::new(),
+            implementation: Implementation::Provided(provided.clone()),
+            summary: provided.summary.clone(),
+            sweeps: Vec::new(),
+            runs_on: None,
+            file: PathBuf::new(),
+            unavailable: None,
+        });
         Ok(())
     }
 
@@ -336,6 +384,7 @@ impl MethodCatalog {
         let base = self.get(base_name).filter(|m| match &m.implementation {
             Implementation::BuiltIn(e) => e.name == m.name,
             Implementation::External(_) => !m.name.contains('['),
+            Implementation::Provided(_) => false,
         });
         base.cloned().ok_or_else(|| {
             format!(
@@ -509,6 +558,9 @@ fn point_implementation(base: &ConfiguredMethod, params: &toml::Table) -> Result
             params: serde_json::to_value(params).map_err(|e| e.to_string())?,
             ..e.clone()
         }),
+        Implementation::Provided(_) => {
+            return Err("a method given in-process takes no parameters".to_string())
+        }
     })
 }
 

@@ -54,6 +54,9 @@ pub struct SuiteOptions {
     /// Run scenarios whose estimated memory exceeds the available memory (`--force`); otherwise
     /// they are refused before their mesh is loaded ([`crate::memory`]).
     pub force: bool,
+    /// Methods given in-process by the program that runs the suite (the Python module's
+    /// `deformbench.run`), added to the catalog; none from the command line.
+    pub provided: Vec<crate::config::ProvidedMethod>,
 }
 
 /// Results of a run, with the scenarios they were computed on.
@@ -290,6 +293,9 @@ pub fn load_catalog(options: &SuiteOptions) -> Result<MethodCatalog, HarnessErro
     if let Some(sweeps) = &options.sweeps {
         catalog.add_sweeps(sweeps)?;
     }
+    for provided in &options.provided {
+        catalog.add_provided(provided)?;
+    }
     Ok(catalog)
 }
 
@@ -405,7 +411,7 @@ fn memory_check(
     let methods: Vec<(String, u64)> = planned_methods(options, catalog, request.spec, request.scenario)
         .filter_map(|(_, m)| match &m.implementation {
             Implementation::BuiltIn(entry) => Some((m.name.clone(), entry.bytes_per_vertex)),
-            Implementation::External(_) => None,
+            Implementation::External(_) | Implementation::Provided(_) => None,
         })
         .collect();
     let estimate = crate::memory::estimate(request.vertices, request.faces, &methods, options.jobs);

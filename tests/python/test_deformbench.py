@@ -39,6 +39,12 @@ def read_off(path):
     return np.array([[float(x) for x in l.split()[:3]] for l in lines[2 : 2 + n]])
 
 
+def metric_keys():
+    """The column names of the metrics table (measures of a unit square left at rest)."""
+    V, F = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]), np.array([[0, 1, 2], [0, 2, 3]])
+    return list(deformbench.measures(V, F, V, fixed=[0, 1], handles=[[2]], targets=[[[1, 1, 0]]]))
+
+
 def without_survey_env():
     env = dict(os.environ)
     env.pop("DEFORM_SURVEY_DIR", None)
@@ -186,6 +192,79 @@ class Errors(unittest.TestCase):
         self.assertAlmostEqual(got["measures"]["e_iso"], 0.0, places=12)
         with self.assertRaisesRegex(ValueError, "V1: 3 rows, V0 has 4"):
             deformbench.measures(self.V, self.F, self.V[:3])
+
+
+class PythonMethods(unittest.TestCase):
+    """`deformbench.run` with Python objects as methods: the example external method's class
+    in-process gives the row its program gives through the protocol; a function and a failing
+    method are reported like external ones."""
+
+    @classmethod
+    def setUpClass(cls):
+        os.chdir(ROOT)
+        os.environ.pop("DEFORM_SURVEY_DIR", None)
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.scenario = os.path.join(cls.tmp.name, "bar.toml")
+        with open(cls.scenario, "w") as f:
+            f.write(f'name = "bar"\nprocedural = {{ shape = "bar", vertices = {VERTICES} }}\n')
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_a_class_in_process_gives_the_row_of_its_program_through_the_protocol(self):
+        import sys
+
+        sys.path.insert(0, os.path.join(ROOT, "external", "example"))
+        from harmonic_displacement import HarmonicDisplacement
+
+        name = "harmonic_displacement"
+        reports = os.path.join(self.tmp.name, "in-process")
+        (ours,) = deformbench.run([self.scenario], [(name, HarmonicDisplacement)], reports=reports)
+        protocol = os.path.join(self.tmp.name, "protocol")
+        args = [harness_binary(), "run", "--configs", "configs", "--scenario", self.scenario, "--quiet"]
+        args += ["--methods", os.path.join(ROOT, "external", "example", "harmonic_displacement.toml")]
+        args += ["--method", name, "--reports", protocol, "--python", sys.executable]
+        done = subprocess.run(args, env=without_survey_env(), capture_output=True, text=True)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(os.path.join(protocol, "results.json")) as f:
+            (theirs,) = json.load(f)["cases"]
+        self.assertEqual(ours["origin"], "external")
+        for key in ["method", "origin", "vertices", "iterations", "converged", "status"]:
+            self.assertEqual(ours[key], theirs[key], key)
+        for key in metric_keys():
+            self.assertEqual(ours[key], theirs[key], key)
+        self.assertTrue(os.path.exists(os.path.join(reports, "index.html")))
+
+    def test_a_function_and_a_failing_method(self):
+        def handles_only(V, F, constrained, targets):
+            """Moves the handles, nothing else: torn at the handles' border."""
+            U = V.copy()
+            U[constrained] = targets
+            return U
+
+        class Broken:
+            def precompute(self, V, F):
+                pass
+
+            def bind(self, regions):
+                pass
+
+            def solve(self, constrained, targets):
+                raise RuntimeError("no solution here")
+
+        reports = os.path.join(self.tmp.name, "function")
+        rows = deformbench.run([self.scenario], ["laplacian", handles_only, ("broken", Broken())], reports=reports)
+        by_method = {r["method"]: r for r in rows}
+        self.assertEqual(set(by_method), {"laplacian", "handles_only", "broken"})
+        self.assertEqual(by_method["handles_only"]["handle_residual_over_diag"], 0.0)
+        self.assertTrue(by_method["handles_only"]["status"].startswith("suspect"), by_method["handles_only"]["status"])
+        self.assertIn("RuntimeError: no solution here", by_method["broken"]["status"])
+        self.assertTrue(by_method["broken"]["status"].startswith("failed"))
+        with self.assertRaisesRegex(ValueError, "neither a method name"):
+            deformbench.run([self.scenario], [42], reports=reports)
+        with self.assertRaisesRegex(deformbench.DeformbenchError, "give the method another name"):
+            deformbench.run([self.scenario], [("arap", handles_only)], reports=reports)
 
 
 if __name__ == "__main__":
