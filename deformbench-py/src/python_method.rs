@@ -70,10 +70,7 @@ impl PythonMethod {
 
     /// The positions of a `solve` answer: an array, or a dict with `positions` (and
     /// `iterations`, `converged`).
-    fn read_answer(
-        &self,
-        answer: &Bound<'_, PyAny>,
-    ) -> Result<(Vec<[f64; 3]>, Option<usize>, Option<bool>), MethodError> {
+    fn read_answer(&self, answer: &Bound<'_, PyAny>) -> Result<Answer, MethodError> {
         let fail = |e: PyErr| error(&self.name, "solve's answer", e);
         let (positions, iterations, converged) = match answer.downcast::<PyDict>() {
             Ok(dict) => {
