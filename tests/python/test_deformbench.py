@@ -267,5 +267,18 @@ class PythonMethods(unittest.TestCase):
             deformbench.run([self.scenario], [("arap", handles_only)], reports=reports)
 
 
+class TheReadmeExample(unittest.TestCase):
+    def test_the_readme_example_runs(self):
+        """README, "From Python": `python examples/python/two_methods.py` from the repository root."""
+        import sys
+
+        done = subprocess.run([sys.executable, os.path.join("examples", "python", "two_methods.py")], cwd=ROOT,
+                              env=without_survey_env(), capture_output=True, text=True)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        lines = done.stdout.splitlines()
+        self.assertTrue(lines[1].startswith("arap") and lines[2].startswith("hirm"), done.stdout)
+        self.assertIn("e_iso", done.stdout)
+
+
 if __name__ == "__main__":
     unittest.main()
