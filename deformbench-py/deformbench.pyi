@@ -104,7 +104,8 @@ def methods() -> list[str]:
     """The names ``Method`` takes: built-in methods and the configuration's variants."""
 
 def load_scenario(path: Union[str, PathLike], survey_dir: Optional[Union[str, PathLike]] = None) -> Scenario:
-    """Load a single-mesh scenario file (``configs/scenarios/bar.toml`` or a user's) on the survey
+    """Load a single-mesh scenario: a file (``configs/scenarios/bar.toml`` or a user's), or the
+    name of one of the configuration's (``"bar"``), on the survey
     data of ``survey_dir`` (default: ``$DEFORM_SURVEY_DIR``), else on its procedural look-alike."""
 
 def measures(

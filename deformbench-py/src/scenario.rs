@@ -125,7 +125,34 @@ impl Scenario {
     }
 }
 
-/// Load the scenario file `path` on the survey data of `survey_dir` (default: the
+/// `path` itself when it is a file, else the scenario of that name in the configuration
+/// (`bar` is `configs/scenarios/bar.toml`), as `harness run --scenario` reads it.
+fn scenario_file(path: PathBuf) -> PyResult<PathBuf> {
+    if path.exists() {
+        return Ok(path);
+    }
+    let dir = crate::configuration::configs_dir().map_err(DeformbenchError::new_err)?.join("scenarios");
+    let named = dir.join(format!("{}.toml", path.display()));
+    if named.is_file() {
+        return Ok(named);
+    }
+    let mut known: Vec<String> = std::fs::read_dir(&dir)
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok()?.path().file_stem().map(|s| s.to_string_lossy().into_owned()))
+                .collect()
+        })
+        .unwrap_or_default();
+    known.sort();
+    Err(DeformbenchError::new_err(format!(
+        "{}: no such file, nor a scenario of {} (known: {})",
+        path.display(),
+        dir.display(),
+        known.join(", ")
+    )))
+}
+
+/// Load the scenario file `path` (or the configuration's scenario of that name) on the survey data of `survey_dir` (default: the
 /// `DEFORM_SURVEY_DIR` environment variable), else on its procedural look-alike.
 #[pyfunction]
 #[pyo3(signature = (path, survey_dir = None))]
@@ -137,6 +164,7 @@ pub fn load_scenario(py: Python<'_>, path: PathBuf, survey_dir: Option<PathBuf>)
         None => DataSource::Procedural,
     };
     let error = |e: harness::HarnessError| DeformbenchError::new_err(e.to_string());
+    let path = scenario_file(path)?;
     let spec = harness::scenario::load_spec(&path).map_err(error)?;
     let mut loaded = py.allow_threads(|| spec.load(&source)).map_err(error)?.scenarios;
     if loaded.len() != 1 {

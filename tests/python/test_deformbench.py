@@ -186,6 +186,11 @@ class Errors(unittest.TestCase):
         np.testing.assert_allclose(V1[:2], self.V[:2], atol=1e-8)
         np.testing.assert_allclose(V1[2], [1, 1, 0.1], atol=1e-8)
 
+    def test_a_scenario_by_name_and_a_wrong_name(self):
+        self.assertEqual(deformbench.load_scenario("cylinder").name, "cylinder")
+        with self.assertRaisesRegex(deformbench.DeformbenchError, "cylindre: no such file, nor a scenario of .*cylinder"):
+            deformbench.load_scenario("cylindre")
+
     def test_measures_of_the_rest_shape(self):
         got = deformbench.verdict(self.V, self.F, self.V, fixed=[0, 1], handles=[[2]], targets=[[[1, 1, 0]]])
         self.assertEqual(got["status"], "ok", got["reasons"])
