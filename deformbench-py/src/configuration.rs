@@ -20,17 +20,20 @@ pub fn configs_dir() -> Result<PathBuf, String> {
 /// Every method of `configs/methods.toml` (built-in, variants, external), read once.
 pub fn catalog() -> pyo3::PyResult<&'static MethodCatalog> {
     static CATALOG: OnceLock<Result<MethodCatalog, String>> = OnceLock::new();
-    CATALOG
-        .get_or_init(|| MethodCatalog::load(&configs_dir()?.join("methods.toml")).map_err(|e| e.to_string()))
-        .as_ref()
-        .map_err(|e| DeformbenchError::new_err(e.clone()))
+    read_once(&CATALOG, |dir| MethodCatalog::load(&dir.join("methods.toml")).map_err(|e| e.to_string()))
 }
 
 /// The verdict rules of `configs/verdicts.toml`, read once.
 pub fn verdict_rules() -> pyo3::PyResult<&'static VerdictRules> {
     static RULES: OnceLock<Result<VerdictRules, String>> = OnceLock::new();
-    RULES
-        .get_or_init(|| VerdictRules::load(&configs_dir()?.join("verdicts.toml")).map_err(|e| e.to_string()))
-        .as_ref()
-        .map_err(|e| DeformbenchError::new_err(e.clone()))
+    read_once(&RULES, |dir| VerdictRules::load(&dir.join("verdicts.toml")).map_err(|e| e.to_string()))
+}
+
+/// The value `cell` holds, read from the configuration directory by `read` on first use; a failed
+/// read is kept too (the files do not change under a running process) and raised each time.
+fn read_once<T>(
+    cell: &'static OnceLock<Result<T, String>>,
+    read: impl FnOnce(&std::path::Path) -> Result<T, String>,
+) -> pyo3::PyResult<&'static T> {
+    cell.get_or_init(|| read(&configs_dir()?)).as_ref().map_err(|e| DeformbenchError::new_err(e.clone()))
 }

@@ -56,6 +56,21 @@ impl Edit {
     }
 }
 
+impl Edit {
+    /// `what` (`f` on the arrays) with the GIL released; an error of the measures (arrays that do
+    /// not fit together) as a `ValueError`, a panic as a [`crate::errors::DeformbenchError`].
+    fn compute<T: Send>(
+        &self,
+        py: Python<'_>,
+        what: &str,
+        f: impl FnOnce(&Edit) -> Result<T, measures::MeasuresError> + Send,
+    ) -> PyResult<T> {
+        py.allow_threads(|| {
+            without_panic(what, || f(self).map_err(|err| PyValueError::new_err(err.to_string())))
+        })
+    }
+}
+
 /// Every measure of the metrics table by its column name (`None` where it does not apply).
 fn quality_dict<'py>(py: Python<'py>, quality: &Quality) -> PyResult<Bound<'py, PyDict>> {
     let dict = PyDict::new(py);
@@ -80,19 +95,16 @@ pub fn measure<'py>(
     reference: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let e = Edit::read(V0, F, V1, fixed, handles, targets, reference)?;
-    let quality = py.allow_threads(|| {
-        without_panic("measures", || {
-            measures::evaluate(
-                &e.rest,
-                &e.faces,
-                &e.result,
-                &e.fixed,
-                &e.handles,
-                &e.targets,
-                e.reference.as_deref(),
-            )
-            .map_err(|err| PyValueError::new_err(err.to_string()))
-        })
+    let quality = e.compute(py, "measures", |e| {
+        measures::evaluate(
+            &e.rest,
+            &e.faces,
+            &e.result,
+            &e.fixed,
+            &e.handles,
+            &e.targets,
+            e.reference.as_deref(),
+        )
     })?;
     quality_dict(py, &quality)
 }
@@ -113,20 +125,9 @@ pub fn judge<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let rules = verdict_rules()?;
     let e = Edit::read(V0, F, V1, fixed, handles, targets, reference)?;
-    let judgement = py.allow_threads(|| {
-        without_panic("verdict", || {
-            measures::judge(
-                rules,
-                &e.rest,
-                &e.faces,
-                &e.result,
-                &e.fixed,
-                &e.handles,
-                &e.targets,
-                e.reference.as_deref(),
-            )
-            .map_err(|err| PyValueError::new_err(err.to_string()))
-        })
+    let judgement = e.compute(py, "verdict", |e| {
+        let (rest, faces, result) = (&e.rest, &e.faces, &e.result);
+        measures::judge(rules, rest, faces, result, &e.fixed, &e.handles, &e.targets, e.reference.as_deref())
     })?;
     let dict = PyDict::new(py);
     dict.set_item("status", if judgement.reasons.is_empty() { "ok" } else { "suspect" })?;

@@ -79,19 +79,14 @@ impl PythonMethod {
                         method: self.name.clone(),
                         message: "solve's answer has no `positions`".into(),
                     })?;
-                let iterations = dict
-                    .get_item("iterations")
-                    .map_err(fail)?
-                    .map(|i| i.extract())
-                    .transpose()
-                    .map_err(fail)?;
-                let converged = dict
-                    .get_item("converged")
-                    .map_err(fail)?
-                    .map(|c| c.extract())
-                    .transpose()
-                    .map_err(fail)?;
-                (positions, iterations, converged)
+                // The optional entries, converted when present.
+                fn entry<'py, T: FromPyObject<'py>>(
+                    dict: &Bound<'py, PyDict>,
+                    key: &str,
+                ) -> PyResult<Option<T>> {
+                    dict.get_item(key)?.map(|value| value.extract()).transpose()
+                }
+                (positions, entry(dict, "iterations").map_err(fail)?, entry(dict, "converged").map_err(fail)?)
             }
             Err(_) => (answer.clone(), None, None),
         };

@@ -258,15 +258,15 @@ impl MethodCatalog {
     /// Add a method given in-process (`deformbench.run`); its name must be new.
     pub fn add_provided(&mut self, provided: &ProvidedMethod) -> Result<(), HarnessError> {
         if let Some(other) = self.get(&provided.name) {
-            let what = if other.file.as_os_str().is_empty() {
+            let whose = if other.file.as_os_str().is_empty() {
                 "a built-in method".to_string()
             } else {
                 format!("an entry of {}", other.file.display())
             };
-            return Err(HarnessError::Config {
-                path: PathBuf::from(&provided.name),
-                message: format!("`{}` is {what}; give the method another name", provided.name),
-            });
+            return Err(HarnessError::Method(MethodError::External {
+                method: provided.name.clone(),
+                message: format!("the name is taken by {whose}; give the method another name"),
+            }));
         }
         self.methods.push(ConfiguredMethod {
             name: provided.name.clone(),

@@ -532,6 +532,7 @@ impl Arap {
             return Ok(second);
         }
         self.current = answer;
+        // The rotations of the kept answer, as its solve left them (the next edit step starts there).
         self.current_energy();
         Ok(SolveSummary { iterations: second.iterations, ..first })
     }
