@@ -62,3 +62,31 @@ pub fn one_ring_turns(rest: &[[f64; 3]], result: &[[f64; 3]], topology: &Topolog
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn triangle() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        (vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.5, 1.5, 0.0]], vec![[0, 1, 2]])
+    }
+
+    #[test]
+    fn a_face_stretches_by_the_singular_values_of_its_gradient() {
+        let (rest, faces) = triangle();
+        // A rotation about z by 0.7 and a translation: both 1.
+        let (c, s) = (0.7f64.cos(), 0.7f64.sin());
+        let turned: Vec<[f64; 3]> =
+            rest.iter().map(|p| [c * p[0] - s * p[1] + 3.0, s * p[0] + c * p[1], 1.0]).collect();
+        let [l, m] = face_stretches(&rest, &turned, &faces)[0].unwrap();
+        assert!((l - 1.0).abs() < 1e-12 && (m - 1.0).abs() < 1e-12, "{l} {m}");
+        // x scaled by 3, y by 0.5 (the rest plane): 3 and 0.5.
+        let squeezed: Vec<[f64; 3]> = rest.iter().map(|p| [3.0 * p[0], 0.5 * p[1], 0.0]).collect();
+        let [l, m] = face_stretches(&rest, &squeezed, &faces)[0].unwrap();
+        assert!((l - 3.0).abs() < 1e-12 && (m - 0.5).abs() < 1e-12, "{l} {m}");
+        // A collapsed result: σ_min 0; a collapsed rest face: none.
+        let flat: Vec<[f64; 3]> = rest.iter().map(|p| [p[0], 0.0, 0.0]).collect();
+        assert_eq!(face_stretches(&rest, &flat, &faces)[0].unwrap()[1], 0.0);
+        assert_eq!(face_stretches(&flat, &rest, &faces)[0], None);
+    }
+}

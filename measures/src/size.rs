@@ -1,5 +1,5 @@
 //! Size: what the handles ask of the size of the surface ([`asked_size`], per handle region from
-//! its own motion), how each face changed size and shape ([`face_stretches`], the singular values
+//! its own motion), how each face changed size and shape ([`face_stretches`](crate::local::face_stretches), the singular values
 //! of its deformation gradient), the isometric distortion they give ([`isometric_distortion`]), and
 //! the share of the surface that shrank or swelled beyond what is asked ([`resized_shares`]).
 //!
@@ -12,7 +12,6 @@ use meshes::vector::{norm, sub};
 use methods::{HandleSet, HandleTargets};
 
 use crate::evaluation::Evaluation;
-pub use crate::local::face_stretches;
 
 /// The range of area factors (`A / A⁰`) the handles ask of the surface. Decision (issue 62), per
 /// handle region from its own motion:
@@ -124,7 +123,7 @@ fn centroids(pairs: &[([f64; 3], [f64; 3])]) -> ([f64; 3], [f64; 3]) {
 
 /// Isometric distortion of `e.result`: `sqrt( Σ_f A⁰_f (ln² σ_max + ln² σ_min) / 2 / Σ_f A⁰_f )`,
 /// the rest-area-weighted RMS over faces of the logs of each face's stretches
-/// ([`face_stretches`]). 0 exactly for a rigid motion, `|ln s|` for a uniform scaling by `s`; it
+/// ([`face_stretches`](crate::local::face_stretches)). 0 exactly for a rigid motion, `|ln s|` for a uniform scaling by `s`; it
 /// sees a change of size (which `E_θ` and `E_φ` do not) and a change of shape (which the total
 /// area does not). A collapsed face gives infinity.
 ///
@@ -186,29 +185,6 @@ pub fn resized_shares(e: &Evaluation) -> (f64, f64) {
 mod tests {
     use super::*;
     use methods::HandleRegion;
-
-    fn triangle() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-        (vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.5, 1.5, 0.0]], vec![[0, 1, 2]])
-    }
-
-    #[test]
-    fn a_face_stretches_by_the_singular_values_of_its_gradient() {
-        let (rest, faces) = triangle();
-        // A rotation about z by 0.7 and a translation: both 1.
-        let (c, s) = (0.7f64.cos(), 0.7f64.sin());
-        let turned: Vec<[f64; 3]> =
-            rest.iter().map(|p| [c * p[0] - s * p[1] + 3.0, s * p[0] + c * p[1], 1.0]).collect();
-        let [l, m] = face_stretches(&rest, &turned, &faces)[0].unwrap();
-        assert!((l - 1.0).abs() < 1e-12 && (m - 1.0).abs() < 1e-12, "{l} {m}");
-        // x scaled by 3, y by 0.5 (the rest plane): 3 and 0.5.
-        let squeezed: Vec<[f64; 3]> = rest.iter().map(|p| [3.0 * p[0], 0.5 * p[1], 0.0]).collect();
-        let [l, m] = face_stretches(&rest, &squeezed, &faces)[0].unwrap();
-        assert!((l - 3.0).abs() < 1e-12 && (m - 0.5).abs() < 1e-12, "{l} {m}");
-        // A collapsed result: σ_min 0; a collapsed rest face: none.
-        let flat: Vec<[f64; 3]> = rest.iter().map(|p| [p[0], 0.0, 0.0]).collect();
-        assert_eq!(face_stretches(&rest, &flat, &faces)[0].unwrap()[1], 0.0);
-        assert_eq!(face_stretches(&flat, &rest, &faces)[0], None);
-    }
 
     fn handles(regions: &[&[u32]], n: usize) -> HandleSet {
         let regions = regions

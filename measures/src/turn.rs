@@ -7,7 +7,6 @@ use methods::rotation_fit::{closest_rotation, cross_covariance, rotation_angle};
 use methods::{HandleSet, HandleTargets};
 
 use crate::evaluation::Evaluation;
-pub use crate::local::one_ring_turns;
 use crate::statistics::percentile;
 
 /// Fraction of the free vertices whose turn [`turn_beyond_handles`] reads: its 90th percentile, so a
@@ -16,7 +15,7 @@ pub const TURN_PERCENTILE: f64 = 0.9;
 
 /// How far the free surface turned beyond what the handles ask (radians, >= 0): the
 /// [`TURN_PERCENTILE`] percentile over the free vertices of `e.handles` of the rotation angle of
-/// their one-ring from rest to result ([`one_ring_turns`]), minus [`asked_turn`]. Issue 24: the
+/// their one-ring from rest to result ([`one_ring_turns`](crate::local::one_ring_turns)), minus [`asked_turn`]. Issue 24: the
 /// unconverged isolines iterates turned the armadillo's torso by 91-96 deg for a hand turned 30.
 pub fn turn_beyond_handles(e: &Evaluation) -> f64 {
     let rest = e.mesh.positions();
