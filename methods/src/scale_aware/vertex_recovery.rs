@@ -94,8 +94,9 @@ impl VertexRecovery {
     /// Step two, lagged when it may be (module documentation): into `next` (`3#V x 1`, interleaved)
     /// the vertices for `#F x 3` `normals` from `3#V` interleaved `current` and `rhs` (`3#V x 1`,
     /// `lambda C V*`). A lagged step is taken when a factorization is held, no normal turned by
-    /// more than `max_turn` (chord length) since it, and its corrections converge; otherwise the
-    /// matrix is refactored and the step is exact. `max_turn = 0` refactors every time.
+    /// more than `max_turn` (chord length) since it, the schedule does not ask for a new one, and
+    /// conjugate gradients converge within a refactorization's cost; otherwise the matrix is
+    /// refactored and the step is exact. `max_turn = 0` refactors every time.
     #[allow(clippy::too_many_arguments)]
     pub fn step(
         &mut self,
@@ -112,10 +113,7 @@ impl VertexRecovery {
         equations.assemble_normal_matrix(normals, constraint_diagonal, self.matrix.val_mut());
         timings.assembly_s += t.elapsed().as_secs_f64();
 
-        if max_turn > 0.0
-            && !self.schedule.due
-            && largest_turn(&self.factored_normals, normals) <= max_turn
-        {
+        if max_turn > 0.0 && !self.schedule.due && largest_turn(&self.factored_normals, normals) <= max_turn {
             let t = std::time::Instant::now();
             let back_substitutions = self.lagged_solve(current, rhs, next);
             timings.back_substitution_s += t.elapsed().as_secs_f64();
