@@ -54,9 +54,7 @@ impl Edit {
         let reference = reference.map(|r| arrays::points("reference", r)).transpose()?;
         Ok(Edit { rest, faces, result, fixed, handles, targets, reference })
     }
-}
 
-impl Edit {
     /// `what` (`f` on the arrays) with the GIL released; an error of the measures (arrays that do
     /// not fit together) as a `ValueError`, a panic as a [`crate::errors::DeformbenchError`].
     fn compute<T: Send>(

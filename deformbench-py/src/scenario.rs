@@ -125,35 +125,30 @@ impl Scenario {
     }
 }
 
-/// `path` itself when it is a file, else the scenario of that name in the configuration
-/// (`bar` is `configs/scenarios/bar.toml`), as `harness run --scenario` reads it.
+/// `path` itself when it is a file, else the file of the configuration's scenario named `path`
+/// (its `name`, as `harness run --scenario` matches it: `bar` is `configs/scenarios/bar.toml`).
 fn scenario_file(path: PathBuf) -> PyResult<PathBuf> {
     if path.exists() {
         return Ok(path);
     }
     let dir = crate::configuration::configs_dir().map_err(DeformbenchError::new_err)?.join("scenarios");
-    let named = dir.join(format!("{}.toml", path.display()));
-    if named.is_file() {
-        return Ok(named);
+    let specs = harness::scenario::load_specs(&dir).map_err(|e| DeformbenchError::new_err(e.to_string()))?;
+    let name = path.to_string_lossy();
+    if let Some(spec) = specs.iter().find(|s| s.name == name) {
+        return Ok(spec.path.clone());
     }
-    let mut known: Vec<String> = std::fs::read_dir(&dir)
-        .map(|entries| {
-            entries
-                .filter_map(|e| e.ok()?.path().file_stem().map(|s| s.to_string_lossy().into_owned()))
-                .collect()
-        })
-        .unwrap_or_default();
-    known.sort();
+    let known: Vec<&str> = specs.iter().map(|s| s.name.as_str()).collect();
     Err(DeformbenchError::new_err(format!(
-        "{}: no such file, nor a scenario of {} (known: {})",
-        path.display(),
+        "{name}: no such file, nor a scenario of {}{} (known: {})",
         dir.display(),
+        harness::error::did_you_mean(&name, known.iter().copied()),
         known.join(", ")
     )))
 }
 
-/// Load the scenario file `path` (or the configuration's scenario of that name) on the survey data of `survey_dir` (default: the
-/// `DEFORM_SURVEY_DIR` environment variable), else on its procedural look-alike.
+/// Load the scenario file `path` (or the configuration's scenario of that name) on the survey data
+/// of `survey_dir` (default: the `DEFORM_SURVEY_DIR` environment variable), else on its
+/// procedural look-alike.
 #[pyfunction]
 #[pyo3(signature = (path, survey_dir = None))]
 pub fn load_scenario(py: Python<'_>, path: PathBuf, survey_dir: Option<PathBuf>) -> PyResult<Scenario> {

@@ -1,7 +1,8 @@
 //! Size: what the handles ask of the size of the surface ([`asked_size`], per handle region from
-//! its own motion), how each face changed size and shape ([`face_stretches`](crate::local::face_stretches), the singular values
-//! of its deformation gradient), the isometric distortion they give ([`isometric_distortion`]), and
-//! the share of the surface that shrank or swelled beyond what is asked ([`resized_shares`]).
+//! its own motion), how each face changed size and shape
+//! ([`face_stretches`](crate::local::face_stretches), the singular values of its deformation
+//! gradient), the isometric distortion they give ([`isometric_distortion`]), and the share of the
+//! surface that shrank or swelled beyond what is asked ([`resized_shares`]).
 //!
 //! Issue 62: the verdicts used to take the asked scale from the spread of all handle targets, so
 //! the survey cylinder's bend, which brings its ends together, "asked" a scale of 0.52 and results
@@ -123,9 +124,9 @@ fn centroids(pairs: &[([f64; 3], [f64; 3])]) -> ([f64; 3], [f64; 3]) {
 
 /// Isometric distortion of `e.result`: `sqrt( Σ_f A⁰_f (ln² σ_max + ln² σ_min) / 2 / Σ_f A⁰_f )`,
 /// the rest-area-weighted RMS over faces of the logs of each face's stretches
-/// ([`face_stretches`](crate::local::face_stretches)). 0 exactly for a rigid motion, `|ln s|` for a uniform scaling by `s`; it
-/// sees a change of size (which `E_θ` and `E_φ` do not) and a change of shape (which the total
-/// area does not). A collapsed face gives infinity.
+/// ([`face_stretches`](crate::local::face_stretches)). 0 exactly for a rigid motion, `|ln s|` for
+/// a uniform scaling by `s`; it sees a change of size (which `E_θ` and `E_φ` do not) and a change
+/// of shape (which the total area does not). A collapsed face gives infinity.
 ///
 /// Decision (issue 62): weighted by rest area, not a plain mean over faces, so the answer does not
 /// depend on how finely a region is meshed: real scans mix slivers and large faces.

@@ -15,8 +15,9 @@ pub const TURN_PERCENTILE: f64 = 0.9;
 
 /// How far the free surface turned beyond what the handles ask (radians, >= 0): the
 /// [`TURN_PERCENTILE`] percentile over the free vertices of `e.handles` of the rotation angle of
-/// their one-ring from rest to result ([`one_ring_turns`](crate::local::one_ring_turns)), minus [`asked_turn`]. Issue 24: the
-/// unconverged isolines iterates turned the armadillo's torso by 91-96 deg for a hand turned 30.
+/// their one-ring from rest to result ([`one_ring_turns`](crate::local::one_ring_turns)), minus
+/// [`asked_turn`]. Issue 24: the unconverged isolines iterates turned the armadillo's torso by
+/// 91-96 deg for a hand turned 30.
 pub fn turn_beyond_handles(e: &Evaluation) -> f64 {
     let rest = e.mesh.positions();
     let region_of = e.handles.region_of();

@@ -532,7 +532,8 @@ impl Arap {
             return Ok(second);
         }
         self.current = answer;
-        // The rotations of the kept answer, as its solve left them (the next edit step starts there).
+        // The perturbed solve left its own rotations: fit them to the kept answer again, so that the
+        // next edit step starts from the first answer's rotations.
         self.current_energy();
         Ok(SolveSummary { iterations: second.iterations, ..first })
     }
