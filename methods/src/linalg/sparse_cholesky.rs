@@ -63,7 +63,7 @@ pub struct SparseCholesky {
     blocked_current: bool,
     /// Workspace of faer's single-column solve.
     single_scratch: MemBuffer,
-    /// Row-major permuted right-hand sides, `n x padded_width(min(k, CHUNK))`.
+    /// Row-major permuted right-hand sides, `blocked.rows() x padded_width(min(k, CHUNK))`.
     workspace: Vec<f64>,
     /// The same for the second thread of a parallel solve.
     workspace_parallel: Vec<f64>,
@@ -102,9 +102,12 @@ impl SparseCholesky {
         .map_err(|e| SolverError::Faer(format!("{e:?}")))?;
         let values = vec![0.0; symbolic.len_val()];
         let par = Par::Seq;
+        let blocked = BlockedFactor::new(symbolic.raw());
+        // Workspace row of every row of the matrix: the fill-reducing permutation, then the
+        // blocked layout's own placement of the factor's columns.
         let perm_inv = match symbolic.perm() {
-            Some(perm) => perm.arrays().1.to_vec(),
-            None => (0..symbolic.nrows()).collect(),
+            Some(perm) => perm.arrays().1.iter().map(|&c| blocked.position(c)).collect(),
+            None => (0..symbolic.nrows()).map(|c| blocked.position(c)).collect(),
         };
         let factor_scratch =
             MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
@@ -115,7 +118,7 @@ impl SparseCholesky {
             blocked_current: false,
             col_ptr: matrix.symbolic().col_ptr().to_vec(),
             row_idx: matrix.symbolic().row_idx().to_vec(),
-            blocked: BlockedFactor::new(symbolic.raw()),
+            blocked,
             symbolic,
             values,
             factorized: false,
@@ -180,8 +183,10 @@ impl SparseCholesky {
     /// A single column is solved by faer on the factor as it is. Several columns are solved
     /// together on the blocked copy of the factor (built on the first such solve after a
     /// factorization), in chunks of up to 16, so they cost much less than as many single solves.
-    /// From 16 columns on, two halves of the columns are solved on two rayon threads. The result for given inputs is bitwise reproducible (it depends on `k`, not on
-    /// thread scheduling).
+    /// From 16 columns on, two halves of the columns are solved on two rayon threads; a large
+    /// factor is also split into parts of its elimination tree swept on separate threads
+    /// (`blocked::tree_split`). The result for given inputs is bitwise reproducible: it depends on
+    /// `k` and the matrix, not on the number of threads or their scheduling.
     ///
     /// # Panics
     /// If called before a successful [`SparseCholesky::factorize`] or with the wrong number of rows
@@ -210,8 +215,9 @@ impl SparseCholesky {
             self.blocked.set_values(&self.values);
             self.blocked_current = true;
         }
-        if k >= PARALLEL_MIN_COLS && rayon::current_num_threads() > 1 {
-            // Two independent column halves on two threads, each with its own workspace.
+        if k >= PARALLEL_MIN_COLS {
+            // Two independent column halves on two threads, each with its own workspace; halved on
+            // one thread too, so that the result does not depend on the thread count.
             let (left, right) = rhs.split_at_col_mut(k.div_ceil(2));
             let (blocked, perm_inv) = (&self.blocked, self.perm_inv.as_slice());
             let (ws_left, ws_right) = (&mut self.workspace, &mut self.workspace_parallel);
@@ -256,16 +262,16 @@ fn solve_columns(
     workspace: &mut Vec<f64>,
     mut rhs: MatMut<'_, f64>,
 ) {
-    let n = rhs.nrows();
+    let rows = blocked.rows();
     let k = rhs.ncols();
     let width = blocked::padded_width(k.min(CHUNK));
-    if workspace.len() < n * width {
-        workspace.resize(n * width, 0.0);
+    if workspace.len() < rows * width {
+        workspace.resize(rows * width, 0.0);
     }
     for c in (0..k).step_by(CHUNK) {
         let kc = CHUNK.min(k - c);
         let width = blocked::padded_width(kc);
-        let x = &mut workspace[..n * width];
+        let x = &mut workspace[..rows * width];
         let mut block = rhs.rb_mut().subcols_mut(c, kc);
         macro_rules! run {
             ($w:literal) => {{
@@ -285,7 +291,7 @@ fn solve_columns(
     }
 }
 
-/// Row `inv[p]` of the row-major `n x W` block `x` is row `p` of `b` (`b.ncols() <= W`), padded with
+/// Row `inv[p]` of the row-major `rows x W` block `x` is row `p` of `b` (`b.ncols() <= W`), padded with
 /// zeros: `x = P b` for the fill-reducing permutation `P` with inverse `inv`.
 fn load_permuted<const W: usize>(b: MatRef<'_, f64>, inv: &[usize], x: &mut [f64]) {
     let k = b.ncols();
@@ -516,6 +522,7 @@ mod tests {
 
     #[test]
     fn supernodal_factors_solve_like_faer() {
+        // The first is split into parts of its elimination tree, the second not.
         for a in [grid(150, 2, 0.01), grid(16, 3, 0.01)] {
             assert!(is_supernodal(&SparseCholesky::analyze(a.as_ref()).unwrap()));
             check_against_faer(&a, SUPERNODAL_THRESHOLD);
@@ -595,5 +602,43 @@ mod tests {
         assert!(transposed.transpose() == x.as_ref());
         // No columns: nothing to do.
         chol.solve_in_place(faer::Mat::<f64>::zeros(n, 0).as_mut());
+    }
+
+    /// Large factors are split into parts of the elimination tree solved on two threads
+    /// (`blocked::tree_split`): the parts carry most of the work, and the solve is bitwise the same
+    /// on one thread as on two.
+    #[test]
+    fn split_factors_solve_alike_on_one_thread_and_two() {
+        for (a, threshold) in [
+            (grid(150, 2, 0.01), SUPERNODAL_THRESHOLD),
+            (grid(22, 3, 0.01), SUPERNODAL_THRESHOLD),
+            (grid(160, 2, 0.01), SupernodalThreshold::FORCE_SIMPLICIAL),
+        ] {
+            let mut chol = SparseCholesky::analyze_with(a.as_ref(), threshold).unwrap();
+            chol.factorize(a.as_ref()).unwrap();
+            let (parts, top) = chol.blocked.split_loads().expect("a factor this large is split");
+            let total = chol.blocked.n_values();
+            let largest = *parts.iter().max().unwrap();
+            eprintln!("n {} values {total}: parts {parts:?}, top {top}", a.nrows());
+            assert_eq!(parts.iter().sum::<usize>() + top, total);
+            assert!(
+                (top + largest) as f64 <= 0.8 * total as f64,
+                "critical path {} of {total}",
+                top + largest
+            );
+            for k in [1, 3, 16] {
+                let b = rhs(a.nrows(), k);
+                let solve_on = |threads: usize, chol: &mut SparseCholesky| {
+                    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                    let mut x = b.clone();
+                    pool.install(|| chol.solve_in_place(x.as_mut()));
+                    x
+                };
+                let one = solve_on(1, &mut chol);
+                let two = solve_on(2, &mut chol);
+                assert!(one == two, "k = {k}: one thread and two differ");
+                assert!(residual(&a, &two, &b) < 1e-8, "k = {k}");
+            }
+        }
     }
 }

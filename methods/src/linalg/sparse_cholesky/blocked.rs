@@ -19,12 +19,22 @@
 //! the pattern is read and written once per block. Kernels are const-generic in `K` so they
 //! vectorize; on x86-64 CPUs with AVX2 and FMA a copy compiled for those features is selected at
 //! run time (once per factor, so a given process gets bitwise reproducible results).
+//!
+//! A large factor is split into parts of its elimination tree that are swept on separate threads,
+//! its columns placed in the workspace part by part ([`tree_split`]); a supernode's rows are then
+//! its workspace rows, not its columns in faer's order ([`BlockedFactor::position`]).
 
 // The kernels address lanes and block rows by index on purpose (fixed-size arrays the compiler
 // keeps in vector registers).
 #![allow(clippy::needless_range_loop)]
 
+mod tree_split;
+
+use std::ops::Range;
+
 use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
+use rayon::prelude::*;
+use tree_split::TreeSplit;
 
 #[cfg(target_arch = "x86_64")]
 use crate::linalg::row_major::Fused;
@@ -68,8 +78,12 @@ fn scale_supernode(source: &[f64], w: usize, p: usize, block: &mut [f64], recip:
 #[derive(Debug, Default)]
 pub(super) struct BlockedFactor {
     n: usize,
-    /// First column of each supernode, then `n`.
-    first_col: Vec<u32>,
+    /// Rows of the workspace a solve runs in: `n`, plus the parts' copies of the top rows when the
+    /// elimination tree is split ([`TreeSplit`]).
+    rows: usize,
+    /// Workspace row of each supernode's first column, and one past its last.
+    col_start: Vec<u32>,
+    col_end: Vec<u32>,
     /// Start of each supernode's row pattern in `pattern`, then the total.
     pattern_ptr: Vec<usize>,
     /// Off-diagonal-block row indices of all supernodes.
@@ -83,6 +97,10 @@ pub(super) struct BlockedFactor {
     faer_base: Vec<usize>,
     /// Use the AVX2 + FMA kernels.
     fused: bool,
+    /// Independent parts of the elimination tree swept on separate threads, if it pays.
+    split: Option<TreeSplit>,
+    /// Workspace row of each column of `L` in faer's (fill-reducing) order.
+    position: Vec<u32>,
 }
 
 impl BlockedFactor {
@@ -94,7 +112,7 @@ impl BlockedFactor {
                 f.n = sym.nrows();
                 let ns = sym.n_supernodes();
                 let val_ptr = sym.col_ptr_for_val();
-                f.first_col.reserve(ns + 1);
+                f.col_start.reserve(ns + 1);
                 f.value_ptr.push(0);
                 f.pattern_ptr.push(0);
                 f.faer_base.reserve(ns);
@@ -103,14 +121,13 @@ impl BlockedFactor {
                     let c0 = sym.supernode_begin()[s];
                     let w = sym.supernode_end()[s] - c0;
                     let pattern = sym.supernode(s).pattern();
-                    f.first_col.push(to_u32(c0));
+                    f.col_start.push(to_u32(c0));
                     f.pattern.extend(pattern.iter().map(|&i| to_u32(i)));
                     f.faer_base.push(val_ptr[s]);
                     len += w * (w + 1) / 2 + pattern.len() * w;
                     f.pattern_ptr.push(f.pattern.len());
                     f.value_ptr.push(len);
                 }
-                f.first_col.push(to_u32(f.n));
             }
             SymbolicCholeskyRaw::Simplicial(sym) => {
                 f.n = sym.nrows();
@@ -139,7 +156,7 @@ impl BlockedFactor {
                         c1 += 1;
                     }
                     let w = c1 - c0;
-                    f.first_col.push(to_u32(c0));
+                    f.col_start.push(to_u32(c0));
                     f.pattern.extend(rows(c1 - 1).skip(1).map(to_u32));
                     let p = f.pattern.len() - f.pattern_ptr.last().unwrap();
                     // Column c0 + j holds rows c0 + j..c1 (offsets 0..w - j), then the pattern.
@@ -154,11 +171,37 @@ impl BlockedFactor {
                     f.value_ptr.push(f.source.len());
                     c0 = c1;
                 }
-                f.first_col.push(to_u32(n));
             }
         }
+        f.col_end = f.col_start.iter().skip(1).copied().chain([to_u32(f.n)]).collect();
+        f.rows = f.n;
+        f.position = (0..f.n).map(to_u32).collect();
         f.values = vec![0.0; *f.value_ptr.last().expect("value_ptr starts with 0")];
+        if let Some(owner) = tree_split::choose(&f) {
+            f.reorder(&owner);
+        }
         f
+    }
+
+    /// Rows of the workspace [`BlockedFactor::solve_row_major`] runs in (at least the order `n`).
+    pub(super) fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Workspace row of column `c` of `L` (faer's fill-reducing order).
+    pub(super) fn position(&self, c: usize) -> usize {
+        self.position[c] as usize
+    }
+
+    /// Supernode `s`: its first and one-past-last workspace rows, its pattern, and its diagonal
+    /// and off-diagonal values.
+    #[inline(always)]
+    fn supernode(&self, s: usize) -> (usize, usize, &[u32], &[f64], &[f64]) {
+        let (c0, c1) = (self.col_start[s] as usize, self.col_end[s] as usize);
+        let w = c1 - c0;
+        let pattern = &self.pattern[self.pattern_ptr[s]..self.pattern_ptr[s + 1]];
+        let (diag, below) = self.values[self.value_ptr[s]..self.value_ptr[s + 1]].split_at(w * (w + 1) / 2);
+        (c0, c1, pattern, diag, below)
     }
 
     /// Take the numeric values of faer's factor (laid out as described by the symbolic structure
@@ -172,7 +215,7 @@ impl BlockedFactor {
         // M = L D^-1 below the diagonal, 1 / L_jj^2 on it.
         let mut recip = Vec::new();
         for s in 0..self.n_supernodes() {
-            let w = (self.first_col[s + 1] - self.first_col[s]) as usize;
+            let w = (self.col_end[s] - self.col_start[s]) as usize;
             let block = &mut self.values[self.value_ptr[s]..self.value_ptr[s + 1]];
             if let Some(&base) = self.faer_base.get(s) {
                 // Faer's column-major `nrows x w` block, entry (i, j) at base + j * nrows + i:
@@ -201,7 +244,7 @@ impl BlockedFactor {
     }
 
     pub(super) fn n_supernodes(&self) -> usize {
-        self.first_col.len() - 1
+        self.col_start.len()
     }
 
     /// Use the portable kernels even where AVX2 and FMA are available.
@@ -210,16 +253,29 @@ impl BlockedFactor {
         self.fused = false;
     }
 
+    /// Stored values swept by each part and by the top of the tree split, if the factor is split.
+    #[cfg(test)]
+    pub(super) fn split_loads(&self) -> Option<(Vec<usize>, usize)> {
+        self.split.as_ref().map(|split| split.loads(self))
+    }
+
+    /// Stored values of the factor in this layout.
+    #[cfg(test)]
+    pub(super) fn n_values(&self) -> usize {
+        self.values.len()
+    }
+
     /// Width of the widest supernode.
     #[cfg(test)]
     pub(super) fn max_supernode_width(&self) -> usize {
-        self.first_col.windows(2).map(|c| (c[1] - c[0]) as usize).max().unwrap_or(0)
+        self.col_start.iter().zip(&self.col_end).map(|(a, b)| (b - a) as usize).max().unwrap_or(0)
     }
 
-    /// Solve `L L^T X = B` in place for a row-major `n x k` block `x` (`x[i * k + j] = B[i, j]`),
-    /// `k` one of 1, 2, 4, 8, 16 (pad other widths with zero columns).
+    /// Solve `L L^T X = B` in place for a row-major `rows() x k` block `x` (`x[r * k + j]`), the
+    /// right-hand side of column `c` of `L` in row `position(c)` (the other rows are workspace), `k`
+    /// one of 1, 2, 4, 8, 16 (pad other widths with zero columns).
     pub(super) fn solve_row_major(&self, x: &mut [f64], k: usize) {
-        assert_eq!(x.len(), self.n * k);
+        assert_eq!(x.len(), self.rows * k);
         // Per width: accumulator sets of the dense row combinations (`NA`) and column block of the
         // off-diagonal updates (`LB`), so that enough independent vector accumulators are in flight.
         match k {
@@ -232,17 +288,72 @@ impl BlockedFactor {
         }
     }
 
+    /// The forward sweep, then the backward one; with a [`TreeSplit`], its parts on rayon threads
+    /// and the top on this one (see [`tree_split`]).
     fn solve_k<const K: usize, const NA: usize, const LB: usize>(&self, x: &mut [f64]) {
+        let Some(split) = &self.split else {
+            let all = 0..self.n_supernodes();
+            self.sweep::<K, NA, LB>(Sweep::Forward, all.clone(), x, 0);
+            self.sweep::<K, NA, LB>(Sweep::Backward, all, x, 0);
+            return;
+        };
+        let top_base = split.top_rows.start;
+        let (body, top) = x.split_at_mut(top_base * K);
+        let mut regions: Vec<(&tree_split::Part, &mut [f64])> = Vec::with_capacity(split.parts.len());
+        let mut rest = body;
+        for part in &split.parts {
+            let (region, after) = std::mem::take(&mut rest).split_at_mut(part.rows.len() * K);
+            regions.push((part, region));
+            rest = after;
+        }
+        // Forward: each part sweeps its subtrees, sending its updates of the top rows to its own
+        // copy of them (zeroed first); the copies are added in part order, so the result does not
+        // depend on the number of threads.
+        regions.par_iter_mut().for_each(|(part, region)| {
+            region[(part.scratch - part.rows.start) * K..].fill(0.0);
+            self.sweep::<K, NA, LB>(Sweep::Forward, part.supernodes.clone(), region, part.rows.start);
+        });
+        for (part, region) in &regions {
+            for (t, u) in top.iter_mut().zip(&region[(part.scratch - part.rows.start) * K..]) {
+                *t += u;
+            }
+        }
+        self.sweep::<K, NA, LB>(Sweep::Forward, split.top.clone(), top, top_base);
+        // Backward: the top first, then each part with a copy of the top rows' final values.
+        self.sweep::<K, NA, LB>(Sweep::Backward, split.top.clone(), top, top_base);
+        let top: &[f64] = top;
+        regions.par_iter_mut().for_each(|(part, region)| {
+            region[(part.scratch - part.rows.start) * K..].copy_from_slice(top);
+            self.sweep::<K, NA, LB>(Sweep::Backward, part.supernodes.clone(), region, part.rows.start);
+        });
+    }
+
+    /// One sweep over `supernodes` (in order forward, in reverse backward) on `region`, the
+    /// workspace rows from `base` on; every row the supernodes touch lies in it.
+    fn sweep<const K: usize, const NA: usize, const LB: usize>(
+        &self,
+        direction: Sweep,
+        supernodes: Range<usize>,
+        region: &mut [f64],
+        base: usize,
+    ) {
         #[cfg(target_arch = "x86_64")]
         if self.fused {
             // SAFETY: `fused` is only set when the CPU supports AVX2 and FMA.
-            unsafe { solve_avx2_fma::<K, NA, LB>(self, x) };
+            unsafe { sweep_avx2_fma::<K, NA, LB>(self, direction, supernodes, region, base) };
             return;
         }
         #[cfg(not(target_arch = "x86_64"))]
         debug_assert!(!self.fused);
-        solve::<K, NA, LB, Separate>(self, x);
+        sweep::<K, NA, LB, Separate>(self, direction, supernodes, region, base);
     }
+}
+
+/// Direction of a triangular sweep: `M z = b` column by column, or `M^T x = y` in reverse.
+#[derive(Clone, Copy, Debug)]
+enum Sweep {
+    Forward,
+    Backward,
 }
 
 /// Width of the workspace block used for `k` right-hand-side columns (`1 <= k <= 16`).
@@ -257,8 +368,14 @@ fn to_u32(i: usize) -> u32 {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn solve_avx2_fma<const K: usize, const NA: usize, const LB: usize>(f: &BlockedFactor, x: &mut [f64]) {
-    solve::<K, NA, LB, Fused>(f, x);
+unsafe fn sweep_avx2_fma<const K: usize, const NA: usize, const LB: usize>(
+    f: &BlockedFactor,
+    direction: Sweep,
+    supernodes: Range<usize>,
+    region: &mut [f64],
+    base: usize,
+) {
+    sweep::<K, NA, LB, Fused>(f, direction, supernodes, region, base);
 }
 
 /// `sum_r coef[r] * x[rows[r] - offset, :]`, like [`combine`](crate::linalg::row_major::combine) but gathering the rows of `x`.
@@ -502,23 +619,41 @@ fn backward_supernode<const K: usize, const NA: usize, const LB: usize, M: MulAd
 }
 
 #[inline(always)]
-fn solve<const K: usize, const NA: usize, const LB: usize, M: MulAdd>(f: &BlockedFactor, x: &mut [f64]) {
-    let ns = f.n_supernodes();
-    let supernode = |s: usize| {
-        let (c0, c1) = (f.first_col[s] as usize, f.first_col[s + 1] as usize);
-        let w = c1 - c0;
-        let pattern = &f.pattern[f.pattern_ptr[s]..f.pattern_ptr[s + 1]];
-        let (diag, below) = f.values[f.value_ptr[s]..f.value_ptr[s + 1]].split_at(w * (w + 1) / 2);
-        (c0, c1, pattern, diag, below)
-    };
-    for s in 0..ns {
-        let (c0, c1, pattern, diag, below) = supernode(s);
-        let (head, tail) = x.split_at_mut(c1 * K);
-        forward_supernode::<K, NA, LB, M>(c1, pattern, diag, below, &mut head[c0 * K..], tail);
-    }
-    for s in (0..ns).rev() {
-        let (c0, c1, pattern, diag, below) = supernode(s);
-        let (head, tail) = x.split_at_mut(c1 * K);
-        backward_supernode::<K, NA, LB, M>(c1, pattern, diag, below, &mut head[c0 * K..], tail);
+fn sweep<const K: usize, const NA: usize, const LB: usize, M: MulAdd>(
+    f: &BlockedFactor,
+    direction: Sweep,
+    supernodes: Range<usize>,
+    x: &mut [f64],
+    base: usize,
+) {
+    match direction {
+        Sweep::Forward => {
+            for s in supernodes {
+                let (c0, c1, pattern, diag, below) = f.supernode(s);
+                let (head, tail) = x.split_at_mut((c1 - base) * K);
+                forward_supernode::<K, NA, LB, M>(
+                    c1,
+                    pattern,
+                    diag,
+                    below,
+                    &mut head[(c0 - base) * K..],
+                    tail,
+                );
+            }
+        }
+        Sweep::Backward => {
+            for s in supernodes.rev() {
+                let (c0, c1, pattern, diag, below) = f.supernode(s);
+                let (head, tail) = x.split_at_mut((c1 - base) * K);
+                backward_supernode::<K, NA, LB, M>(
+                    c1,
+                    pattern,
+                    diag,
+                    below,
+                    &mut head[(c0 - base) * K..],
+                    tail,
+                );
+            }
+        }
     }
 }
