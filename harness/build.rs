@@ -1,10 +1,29 @@
-//! Records the compiler and profile of this build for the run provenance (`harness/src/provenance.rs`),
+//! Records the compiler, profile and git state of this build for the run provenance
+//! (`harness/src/provenance.rs`; the git state by `src/provenance/git_state.rs`, included here),
 //! and compiles the project's files into the binary (`harness/src/paths.rs`): the configuration
 //! (`configs/`), the committed baselines (`reports/baselines/`), the Python scripts the harness
 //! runs (`python/`, `external/`). An installed binary run where there is no `./configs` uses them.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+
+#[path = "src/provenance/git_state.rs"]
+mod git_state;
+
+/// What the workspace's tracked sources are, relative to its root: a change under any of them can
+/// change the checkout's git state, so the state is read again (`rerun-if-changed`).
+const SOURCE_PATHS: [&str; 10] = [
+    "Cargo.toml",
+    "Cargo.lock",
+    "meshes",
+    "methods",
+    "measures",
+    "harness/src",
+    "harness/Cargo.toml",
+    "harness/build.rs",
+    "tests",
+    "scripts",
+];
 
 /// The directories of the workspace compiled in, relative to the workspace root.
 const PROJECT_DIRS: [&str; 4] = ["configs", "reports/baselines", "python", "external"];
@@ -25,7 +44,25 @@ fn main() {
     println!("cargo:rustc-env=DEFORMBENCH_PROFILE={}", std::env::var("PROFILE").unwrap_or_default());
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-env-changed=RUSTC");
+    record_git_state();
     embed_project_files();
+}
+
+/// The git state of the checkout being built (commit, dirty, diff hash), for the provenance of
+/// every run of this binary; read again when `HEAD` moves or a source changes.
+fn record_git_state() {
+    let root = Path::new(&std::env::var("CARGO_MANIFEST_DIR").unwrap()).join("..");
+    let state = git_state::read(&root);
+    println!("cargo:rustc-env=DEFORMBENCH_GIT_COMMIT={}", state.commit.unwrap_or_default());
+    let dirty = state.dirty.map(|d| d.to_string()).unwrap_or_default();
+    println!("cargo:rustc-env=DEFORMBENCH_GIT_DIRTY={dirty}");
+    println!("cargo:rustc-env=DEFORMBENCH_GIT_DIFF_SHA256={}", state.diff_sha256.unwrap_or_default());
+    for file in git_state::head_files(&root) {
+        println!("cargo:rerun-if-changed={}", file.display());
+    }
+    for path in SOURCE_PATHS {
+        println!("cargo:rerun-if-changed={}", root.join(path).display());
+    }
 }
 
 /// Writes `$OUT_DIR/project_files.rs`: `PROJECT_FILES`, a sorted `(relative path, bytes)` table.

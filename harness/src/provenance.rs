@@ -1,10 +1,15 @@
 //! Where and how a run was made, written at the top of `results.json` and of the page: the machine
-//! (CPU, logical cores, memory, OS and kernel), the build (crate version, git commit of the workspace,
-//! whether its tree was dirty when the run started and then the SHA-256 of its diff, rustc, profile)
-//! and the run (start time,
+//! (CPU, logical cores, memory, OS and kernel), the build (crate version, git commit of the checkout
+//! the binary was built from, whether its tree was dirty then and the SHA-256 of its diff, rustc,
+//! profile; all compiled in by `build.rs`) and the run (start time,
 //! command line, threads, jobs, repetitions). Anything that cannot be read is `unknown`, never an
 //! error: a record is a courtesy to the reader, not a precondition of the run.
 
+// Also compiled into build.rs, which uses all of it; the library itself needs only the diff hash.
+#[allow(dead_code)]
+mod git_state;
+
+pub use git_state::diff_sha256;
 use serde::{Deserialize, Serialize};
 
 /// The record of one run.
@@ -40,9 +45,9 @@ pub struct Machine {
 pub struct Build {
     /// The harness crate's version.
     pub version: String,
-    /// `git rev-parse HEAD` of the workspace, when it is a git checkout.
+    /// `git rev-parse HEAD` of the checkout this binary was built from, when it was one.
     pub git_commit: Option<String>,
-    /// Whether tracked files differed from that commit when the run started.
+    /// Whether tracked files differed from that commit when the binary was built.
     pub git_dirty: Option<bool>,
     /// When dirty: the SHA-256 of the uncommitted change ([`diff_sha256`]), so that runs of two
     /// states of one commit's tree are told apart (the history keeps them as points of their own).
@@ -153,65 +158,20 @@ impl Machine {
 }
 
 impl Build {
+    /// The build this binary is: the git state of its checkout when it was compiled (`build.rs`),
+    /// not the checkout's state now. A binary copied away, or kept while the checkout moved on,
+    /// still records the commit and diff it was built from.
     fn read() -> Self {
-        // The checkout this binary was compiled from: the build is what the record describes, not
-        // the directory the run was started in. Read at run time, so a checkout that moved on since
-        // the build records its new HEAD (the binary is then stale); one that is gone records none.
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-        let git = |args: &[&str]| {
-            std::process::Command::new("git")
-                .arg("-C")
-                .arg(&root)
-                .args(args)
-                .output()
-                .ok()
-                .filter(|o| o.status.success())
-                .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-        };
-        let git_commit = git(&["rev-parse", "HEAD"]);
-        let git_dirty = git_commit
-            .as_ref()
-            .and_then(|_| git(&["status", "--porcelain", "--untracked-files=no"]))
-            .map(|status| !status.is_empty());
-        let git_diff_sha256 = if git_dirty == Some(true) { diff_sha256(&root) } else { None };
+        let compiled = |value: &'static str| Some(value.to_string()).filter(|v| !v.is_empty());
         Build {
             version: env!("CARGO_PKG_VERSION").to_string(),
-            git_commit,
-            git_dirty,
-            git_diff_sha256,
+            git_commit: compiled(env!("DEFORMBENCH_GIT_COMMIT")),
+            git_dirty: compiled(env!("DEFORMBENCH_GIT_DIRTY")).map(|d| d == "true"),
+            git_diff_sha256: compiled(env!("DEFORMBENCH_GIT_DIFF_SHA256")),
             rustc: env!("DEFORMBENCH_RUSTC_VERSION").to_string(),
             profile: env!("DEFORMBENCH_PROFILE").to_string(),
         }
     }
-}
-
-/// The SHA-256 (hex) of the uncommitted change of the git checkout at `repo`: the bytes of `git diff
-/// HEAD --binary`, staged and unstaged changes of tracked files, with the options that the user's
-/// git configuration could change fixed (no external diff, textconv, colour or renames, `a/` and
-/// `b/` prefixes). Decision: untracked files are not part of it, as they are not of `git_dirty`
-/// (`git status --untracked-files=no`): reports, logs and scratch files in a checkout would make
-/// every run a state of its own. A new source file counts once it is added (`git add -N` is
-/// enough). `None` when git cannot say.
-pub fn diff_sha256(repo: &std::path::Path) -> Option<String> {
-    use sha2::Digest;
-    let out = std::process::Command::new("git")
-        .arg("-C")
-        .arg(repo)
-        .args([
-            "diff",
-            "HEAD",
-            "--binary",
-            "--no-ext-diff",
-            "--no-textconv",
-            "--no-color",
-            "--no-renames",
-            "--src-prefix=a/",
-            "--dst-prefix=b/",
-        ])
-        .output()
-        .ok()
-        .filter(|o| o.status.success())?;
-    Some(sha2::Sha256::digest(&out.stdout).iter().map(|b| format!("{b:02x}")).collect())
 }
 
 /// An external method and its own account of itself.
@@ -365,6 +325,44 @@ mod tests {
         std::fs::write(repo.join("scratch.txt"), "untracked").unwrap();
         assert_eq!(diff_sha256(repo).unwrap(), two, "an untracked file is not part of it");
         assert_eq!(diff_sha256(&repo.join("no-such-dir")), None);
+    }
+
+    /// What build.rs compiles into the binary: the commit, dirtiness and diff of the checkout, and
+    /// the files whose change moves `HEAD`.
+    #[test]
+    fn the_git_state_follows_commits_and_changes() {
+        let dir = tempfile::tempdir().unwrap();
+        let repo = dir.path();
+        let git = |args: &[&str]| {
+            let out = std::process::Command::new("git")
+                .arg("-C")
+                .arg(repo)
+                .args(["-c", "user.name=t", "-c", "user.email=t@t", "-c", "commit.gpgsign=false"])
+                .args(args)
+                .output()
+                .unwrap();
+            assert!(out.status.success(), "git {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+            String::from_utf8_lossy(&out.stdout).trim().to_string()
+        };
+        git(&["init", "--quiet", "--initial-branch=trunk"]);
+        std::fs::write(repo.join("a.txt"), "one\n").unwrap();
+        git(&["add", "a.txt"]);
+        git(&["commit", "--quiet", "-m", "one"]);
+        let one = git_state::read(repo);
+        assert_eq!(one.commit.as_deref(), Some(git(&["rev-parse", "HEAD"]).as_str()));
+        assert_eq!((one.dirty, one.diff_sha256.as_deref()), (Some(false), None));
+        std::fs::write(repo.join("a.txt"), "two\n").unwrap();
+        let changed = git_state::read(repo);
+        assert_eq!((changed.commit.as_ref(), changed.dirty), (one.commit.as_ref(), Some(true)));
+        assert_eq!(changed.diff_sha256, diff_sha256(repo));
+        git(&["commit", "--quiet", "-am", "two"]);
+        let two = git_state::read(repo);
+        assert!(two.commit != one.commit && two.dirty == Some(false));
+        let files = git_state::head_files(repo);
+        for name in ["HEAD", "packed-refs", "trunk"] {
+            assert!(files.iter().any(|f| f.ends_with(name) && f.is_absolute()), "{name} in {files:?}");
+        }
+        assert_eq!(git_state::read(&repo.join("no-such-dir")), git_state::GitState::default());
     }
 
     #[test]
