@@ -241,8 +241,11 @@ fn arap_started_by_transformation_propagation_converges_in_fewer_iterations() {
     let (from_rest, _) = solve("current", 20000, &twist);
     let (propagated, _) = solve("transformation_propagation", 20000, &twist);
     assert!(from_rest.converged && propagated.converged, "{from_rest:?} {propagated:?}");
+    // The counts move by about 10% with the last bits of the rotation fit (propagated 517 and rest
+    // 2190 with the Jacobi SVD, 563 and 2133 with Newton's fit; docs/results.md, issue 63), so the
+    // test asks for 3x, within the documented 2-7x.
     assert!(
-        4 * propagated.iterations <= from_rest.iterations,
+        3 * propagated.iterations <= from_rest.iterations,
         "propagated start {} iterations, rest start {}",
         propagated.iterations,
         from_rest.iterations

@@ -72,7 +72,7 @@ use crate::method::{
 };
 use crate::operators::{laplacian, LaplacianWeights};
 use crate::params::ParamCheck;
-use crate::rotation_fit::{closest_rotation_warm, Mat3};
+use crate::rotation_fit::{closest_rotation_near, Mat3};
 
 /// Parameters of [`Arap`] (configs/methods.toml, section `[arap]`).
 #[derive(Clone, Debug, Deserialize)]
@@ -280,6 +280,9 @@ impl Arap {
         &self.rotations
     }
 
+    /// SA07's local step (eq 5-6): into `rotations` (`#V`; on entry the last fit, where each fit
+    /// starts) the rotation best mapping each rest one-ring to `current`'s (`#V x 3`); `frames`
+    /// (`#V`) are the warm singular frames of the SVD fallback.
     fn local_step(spokes: &Spokes, current: &[[f64; 3]], rotations: &mut [Mat3], frames: &mut [Mat3]) {
         rotations.par_iter_mut().zip(frames.par_iter_mut()).enumerate().with_min_len(256).for_each(
             |(i, (r, frame))| {
@@ -296,7 +299,10 @@ impl Arap {
                         }
                     }
                 }
-                *r = closest_rotation_warm(&cov, frame);
+                // The last rotation is a close start: the quaternion fit, the Jacobi SVD from
+                // the last singular frame where that does not converge.
+                let previous = *r;
+                *r = closest_rotation_near(&cov, &previous, frame);
             },
         );
     }
