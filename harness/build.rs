@@ -57,11 +57,11 @@ fn record_git_state() {
     let dirty = state.dirty.map(|d| d.to_string()).unwrap_or_default();
     println!("cargo:rustc-env=DEFORMBENCH_GIT_DIRTY={dirty}");
     println!("cargo:rustc-env=DEFORMBENCH_GIT_DIFF_SHA256={}", state.diff_sha256.unwrap_or_default());
-    for file in git_state::head_files(&root) {
+    // Only paths that exist: cargo reruns a build script on every build for a missing one (a
+    // repository without packed refs, a source tree without tests/).
+    let sources = SOURCE_PATHS.iter().map(|path| root.join(path));
+    for file in git_state::head_files(&root).into_iter().chain(sources).filter(|f| f.exists()) {
         println!("cargo:rerun-if-changed={}", file.display());
-    }
-    for path in SOURCE_PATHS {
-        println!("cargo:rerun-if-changed={}", root.join(path).display());
     }
 }
 
