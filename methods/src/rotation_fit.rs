@@ -171,7 +171,7 @@ fn newton_rotation(m: &Mat3, guess: &Mat3) -> Option<Mat3> {
 }
 
 /// The rotation of the unit quaternion `q = (w, x, y, z)`.
-fn rotation_of(q: [f64; 4]) -> Mat3 {
+pub(crate) fn rotation_of(q: [f64; 4]) -> Mat3 {
     let [w, x, y, z] = q;
     [
         [w * w + x * x - y * y - z * z, 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)],
@@ -182,7 +182,7 @@ fn rotation_of(q: [f64; 4]) -> Mat3 {
 
 /// A unit quaternion of the rotation `r` (Shepperd: from the largest of `1 + tr` and the
 /// diagonal's, so no small divisor).
-fn quaternion_of(r: &Mat3) -> [f64; 4] {
+pub(crate) fn quaternion_of(r: &Mat3) -> [f64; 4] {
     let t = r[0][0] + r[1][1] + r[2][2];
     let q = if t >= r[0][0].max(r[1][1]).max(r[2][2]) {
         let w = (1.0 + t).max(0.0).sqrt() * 2.0;

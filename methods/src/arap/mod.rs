@@ -299,8 +299,8 @@ impl Arap {
                         }
                     }
                 }
-                // The last rotation is a close start: the quaternion fit, the Jacobi SVD from
-                // the last singular frame where that does not converge.
+                // The last rotation is a close start for Newton's fit; the Jacobi SVD from the
+                // last singular frame answers where Newton does not converge.
                 let previous = *r;
                 *r = closest_rotation_near(&cov, &previous, frame);
             },

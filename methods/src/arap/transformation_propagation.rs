@@ -21,7 +21,9 @@ use faer::Mat;
 
 use crate::handles::{HandleSet, HandleTargets, FREE};
 use crate::linalg::sparse_cholesky::SparseCholesky;
-use crate::rotation_fit::{closest_rotation, cross_covariance, singular_values, Mat3, IDENTITY};
+use crate::rotation_fit::{
+    closest_rotation, cross_covariance, quaternion_of, rotation_of, singular_values, Mat3, IDENTITY,
+};
 
 use super::Spokes;
 
@@ -80,11 +82,11 @@ pub(super) fn harmonic_weights(
 
 /// Per vertex, the blend of `rotations` (one per region) by the row of `weights` (`#V x #regions`).
 pub(super) fn blend(rotations: &[Mat3], weights: &Mat<f64>, out: &mut [Mat3]) {
-    let first = to_quaternion(&rotations[0]);
+    let first = quaternion_of(&rotations[0]);
     let quaternions: Vec<[f64; 4]> = rotations
         .iter()
         .map(|r| {
-            let q = to_quaternion(r);
+            let q = quaternion_of(r);
             let d: f64 = (0..4).map(|a| q[a] * first[a]).sum();
             if d < 0.0 {
                 q.map(|c| -c)
@@ -101,7 +103,7 @@ pub(super) fn blend(rotations: &[Mat3], weights: &Mat<f64>, out: &mut [Mat3]) {
             }
         }
         let norm = q.iter().map(|c| c * c).sum::<f64>().sqrt();
-        *r = if norm > 1e-12 { from_quaternion(&q.map(|c| c / norm)) } else { IDENTITY };
+        *r = if norm > 1e-12 { rotation_of(q.map(|c| c / norm)) } else { IDENTITY };
     }
 }
 
@@ -115,51 +117,20 @@ fn centroid(p: &[[f64; 3]]) -> [f64; 3] {
     c.map(|x| x / p.len().max(1) as f64)
 }
 
-/// The unit quaternion `[w, x, y, z]` of a rotation matrix (Shepperd's method: the largest of the
-/// four diagonal combinations is taken for the square root, so no division by a small number).
-fn to_quaternion(r: &Mat3) -> [f64; 4] {
-    let t = r[0][0] + r[1][1] + r[2][2];
-    let q = if t >= r[0][0].max(r[1][1]).max(r[2][2]) {
-        let s = (1.0 + t).sqrt() * 2.0;
-        [0.25 * s, (r[2][1] - r[1][2]) / s, (r[0][2] - r[2][0]) / s, (r[1][0] - r[0][1]) / s]
-    } else if r[0][0] >= r[1][1] && r[0][0] >= r[2][2] {
-        let s = (1.0 + r[0][0] - r[1][1] - r[2][2]).sqrt() * 2.0;
-        [(r[2][1] - r[1][2]) / s, 0.25 * s, (r[0][1] + r[1][0]) / s, (r[0][2] + r[2][0]) / s]
-    } else if r[1][1] >= r[2][2] {
-        let s = (1.0 + r[1][1] - r[0][0] - r[2][2]).sqrt() * 2.0;
-        [(r[0][2] - r[2][0]) / s, (r[0][1] + r[1][0]) / s, 0.25 * s, (r[1][2] + r[2][1]) / s]
-    } else {
-        let s = (1.0 + r[2][2] - r[0][0] - r[1][1]).sqrt() * 2.0;
-        [(r[1][0] - r[0][1]) / s, (r[0][2] + r[2][0]) / s, (r[1][2] + r[2][1]) / s, 0.25 * s]
-    };
-    let norm = q.iter().map(|c| c * c).sum::<f64>().sqrt();
-    q.map(|c| c / norm)
-}
-
-/// The rotation matrix of the unit quaternion `[w, x, y, z]`.
-fn from_quaternion(q: &[f64; 4]) -> Mat3 {
-    let [w, x, y, z] = *q;
-    [
-        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)],
-        [2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)],
-        [2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)],
-    ]
-}
-
 #[cfg(test)]
 mod tests {
     use meshes::AffineTransform;
 
-    use super::{blend, from_quaternion, region_rotations, to_quaternion};
+    use super::{blend, region_rotations};
     use crate::arap::{Arap, ArapParams, ArapStart};
     use crate::handles::{HandleRegion, HandleSet, HandleTargets};
     use crate::method::DeformationMethod;
-    use crate::rotation_fit::{rotation_angle, Mat3, IDENTITY};
+    use crate::rotation_fit::{quaternion_of, rotation_angle, rotation_of, Mat3, IDENTITY};
 
     fn rotation(axis: [f64; 3], angle: f64) -> Mat3 {
         let n = axis.iter().map(|c| c * c).sum::<f64>().sqrt();
         let h = 0.5 * angle;
-        from_quaternion(&[h.cos(), h.sin() * axis[0] / n, h.sin() * axis[1] / n, h.sin() * axis[2] / n])
+        rotation_of([h.cos(), h.sin() * axis[0] / n, h.sin() * axis[1] / n, h.sin() * axis[2] / n])
     }
 
     #[test]
@@ -188,7 +159,7 @@ mod tests {
         {
             let r = rotation(axis, angle);
             assert!((rotation_angle(&r) - angle).abs() < 1e-12);
-            let back = from_quaternion(&to_quaternion(&r));
+            let back = rotation_of(quaternion_of(&r));
             for a in 0..3 {
                 for b in 0..3 {
                     assert!((back[a][b] - r[a][b]).abs() < 1e-14, "{axis:?} {angle}");

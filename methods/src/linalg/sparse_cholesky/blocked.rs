@@ -630,30 +630,29 @@ fn sweep<const K: usize, const NA: usize, const LB: usize, M: MulAdd>(
         Sweep::Forward => {
             for s in supernodes {
                 let (c0, c1, pattern, diag, below) = f.supernode(s);
-                let (head, tail) = x.split_at_mut((c1 - base) * K);
-                forward_supernode::<K, NA, LB, M>(
-                    c1,
-                    pattern,
-                    diag,
-                    below,
-                    &mut head[(c0 - base) * K..],
-                    tail,
-                );
+                let (top, tail) = rows_and_below::<K>(x, c0, c1, base);
+                forward_supernode::<K, NA, LB, M>(c1, pattern, diag, below, top, tail);
             }
         }
         Sweep::Backward => {
             for s in supernodes.rev() {
                 let (c0, c1, pattern, diag, below) = f.supernode(s);
-                let (head, tail) = x.split_at_mut((c1 - base) * K);
-                backward_supernode::<K, NA, LB, M>(
-                    c1,
-                    pattern,
-                    diag,
-                    below,
-                    &mut head[(c0 - base) * K..],
-                    tail,
-                );
+                let (top, tail) = rows_and_below::<K>(x, c0, c1, base);
+                backward_supernode::<K, NA, LB, M>(c1, pattern, diag, below, top, tail);
             }
         }
     }
+}
+
+/// Rows `c0..c1` of the row-major block `x` (`K` wide, holding workspace rows from `base` on), and
+/// the rows after them.
+#[inline(always)]
+fn rows_and_below<const K: usize>(
+    x: &mut [f64],
+    c0: usize,
+    c1: usize,
+    base: usize,
+) -> (&mut [f64], &mut [f64]) {
+    let (head, tail) = x.split_at_mut((c1 - base) * K);
+    (&mut head[(c0 - base) * K..], tail)
 }
