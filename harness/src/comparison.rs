@@ -326,7 +326,8 @@ fn finding_case(f: &Finding) -> Option<CaseKey> {
         | Finding::Failed { scenario, method, .. }
         | Finding::NonFinite { scenario, method, .. }
         | Finding::Better { scenario, method, .. }
-        | Finding::Improved { scenario, method, .. } => Some(CaseKey::new(scenario, method)),
+        | Finding::Improved { scenario, method, .. }
+        | Finding::IterateNotCompared { scenario, method } => Some(CaseKey::new(scenario, method)),
         Finding::Missing { .. } => None,
     }
 }

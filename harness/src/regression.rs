@@ -6,6 +6,15 @@
 //! suspect -> unfinished), failed or produced a non-finite measure, and every baseline case the run
 //! lacks. Improvements pass (and are listed, so the
 //! baseline can be renewed on purpose with `harness baseline`).
+//!
+//! A case unfinished both in the baseline and in the run is not compared measure by measure (it is
+//! listed): its measures are of the iterate at the cap, not of an answer, and that iterate moves
+//! with any change of the solver's path. Measured on the dataset's smoke set (docs/results.md,
+//! issue 63): `scale_aware` on the block, which Algorithm 1 does not bring within a diagonal of a
+//! fixed point in 200 iterations, moved its fold share by up to +28% and its estimated distance
+//! between 0.16 and 1.2 diagonals across step two's stationary corrections and conjugate gradients
+//! to 1e-2, 1e-3 and 1e-4, while every finished case stayed within its tolerance. Turning
+//! unfinished still fails the gate.
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fmt;
@@ -118,12 +127,15 @@ pub enum Finding {
     Better { scenario: String, method: String, metric: Metric, baseline: f64, current: f64 },
     /// A better status kind than in the baseline (`from`; not a failure).
     Improved { scenario: String, method: String, from: String, to: String },
+    /// Unfinished in the baseline and in the run: its measures, of an iterate, were not compared
+    /// (module documentation; not a failure).
+    IterateNotCompared { scenario: String, method: String },
 }
 
 impl Finding {
     /// Whether this finding fails the gate.
     pub fn is_regression(&self) -> bool {
-        !matches!(self, Finding::Better { .. } | Finding::Improved { .. })
+        !matches!(self, Finding::Better { .. } | Finding::Improved { .. } | Finding::IterateNotCompared { .. })
     }
 }
 
@@ -156,6 +168,11 @@ impl fmt::Display for Finding {
             Finding::Improved { scenario, method, from, to } => {
                 write!(f, "now {to}: {scenario} / {method} ({from} in the baseline)")
             }
+            Finding::IterateNotCompared { scenario, method } => write!(
+                f,
+                "not compared: {scenario} / {method}: unfinished in the baseline and in the run, its \
+                 measures are of an iterate at the cap"
+            ),
         }
     }
 }
@@ -225,6 +242,11 @@ pub fn check(baseline: &Baseline, results: &[CaseResult]) -> Vec<Finding> {
             continue;
         }
         let reference = index.get(&r.key()).copied();
+        let unfinished = STATUS_KINDS[2];
+        let iterates = reference.is_some_and(|b| b.verdict == unfinished) && r.status.kind() == unfinished;
+        if iterates {
+            findings.push(Finding::IterateNotCompared { scenario: scenario.clone(), method: method.clone() });
+        }
         let rank = |kind: &str| STATUS_KINDS.iter().position(|k| *k == kind);
         if let Some((from, was, now)) =
             reference.and_then(|b| Some((b.verdict.clone(), rank(&b.verdict)?, rank(r.status.kind())?)))
@@ -244,6 +266,9 @@ pub fn check(baseline: &Baseline, results: &[CaseResult]) -> Vec<Finding> {
                     method: method.clone(),
                     metric,
                 });
+                continue;
+            }
+            if iterates {
                 continue;
             }
             let Some(base) = reference.and_then(|b| b.metrics.get(metric.key())).copied() else { continue };
@@ -456,6 +481,32 @@ mod tests {
         let findings = check(&baseline_from(&r), &run());
         assert!(findings.len() == 1 && !findings[0].is_regression(), "{findings:?}");
         assert!(findings[0].to_string().starts_with("now ok: bar / arap (unfinished in the baseline)"));
+    }
+
+    #[test]
+    fn a_case_unfinished_in_both_is_listed_not_compared_but_its_non_finite_measures_fail() {
+        let unfinished = Status::Unfinished(vec!["stopped at the 200-iteration cap".into()]);
+        let mut before = run();
+        before[0].status = unfinished.clone();
+        let base = baseline_from(&before);
+        // The iterate at the cap moved: a measure far worse is not a regression, and is not named.
+        let mut r = before.clone();
+        let e_phi = r[0].quality.get(Metric::EPhi).unwrap();
+        r[0].quality.set(Metric::EPhi, Some(10.0 * e_phi));
+        let findings = check(&base, &r);
+        assert!(findings.len() == 1 && !findings[0].is_regression(), "{findings:?}");
+        assert!(
+            findings[0].to_string().starts_with("not compared: bar / arap: unfinished in the baseline and in the run"),
+            "{}",
+            findings[0]
+        );
+        // The same change on a case finished in the run is compared (it is now ok: listed as such).
+        let mut finished = r.clone();
+        finished[0].status = Status::Ok;
+        assert!(check(&base, &finished).iter().any(|f| matches!(f, Finding::Worse { metric: Metric::EPhi, .. })));
+        // A non-finite measure still fails.
+        r[0].quality.set(Metric::EPhi, Some(f64::NAN));
+        assert!(check(&base, &r).iter().any(|f| matches!(f, Finding::NonFinite { .. }) && f.is_regression()));
     }
 
     #[test]
