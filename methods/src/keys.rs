@@ -57,9 +57,11 @@ pub mod statistic {
     /// scale_aware's outer iterations and Gauss-map (normal) iterations.
     pub const OUTER_ITERATIONS: &str = "outer_iterations";
     pub const NORMAL_ITERATIONS: &str = "normal_iterations";
-    /// scale_aware's step two: numeric factorizations, and lagged steps with a held one.
+    /// scale_aware's step two: numeric factorizations, lagged steps with a held one, and the
+    /// back-substitutions of those (conjugate gradients preconditioned by the held factor).
     pub const REFACTORIZATIONS: &str = "refactorizations";
     pub const LAGGED_STEPS: &str = "lagged_steps";
+    pub const LAGGED_BACK_SUBSTITUTIONS: &str = "lagged_back_substitutions";
     /// arap's saddle test: the relative energies of the first answer and of the perturbed solve's,
     /// and whether the latter is the result (1) or not (0).
     pub const SADDLE_TEST_FIRST_ENERGY: &str = "saddle_test_first_energy";

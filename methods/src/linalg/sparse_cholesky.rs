@@ -230,6 +230,24 @@ impl SparseCholesky {
         }
     }
 
+    /// Multiply-adds of one numeric factorization, `sum_j c_j^2` over the factor's column counts
+    /// `c_j` (diagonal included), from the symbolic analysis alone.
+    pub fn factorization_work(&self) -> f64 {
+        use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(sym) => (0..sym.n_supernodes())
+                .map(|s| {
+                    let w = sym.supernode_end()[s] - sym.supernode_begin()[s];
+                    let p = sym.supernode(s).pattern().len();
+                    (1..=w).map(|c| ((c + p) as f64).powi(2)).sum::<f64>()
+                })
+                .sum(),
+            SymbolicCholeskyRaw::Simplicial(sym) => {
+                sym.col_ptr().windows(2).map(|w| ((w[1] - w[0]) as f64).powi(2)).sum()
+            }
+        }
+    }
+
     /// Number of stored entries of the factor (fill-in indicator).
     pub fn factor_nnz(&self) -> usize {
         self.symbolic.len_val()
