@@ -848,7 +848,7 @@ fn compare_calls_a_slower_method_slower_and_says_what_differs_between_the_runs()
     let tail = methods[arap..]
         .replacen("solver = \"lbfgs\"", "solver = \"local_global\"", 1)
         .replacen("acceleration = \"anderson\"", "acceleration = \"none\"", 1)
-        .replacen("max_iterations = 1000", "max_iterations = 20000", 1);
+        .replacen("max_iterations = 2000", "max_iterations = 20000", 1);
     std::fs::write(plain.path().join("methods.toml"), format!("{}{tail}", &methods[..arap])).unwrap();
     let work = tempfile::tempdir().unwrap();
     let dir = |name: &str| work.path().join(name).to_str().unwrap().to_string();

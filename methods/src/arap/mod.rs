@@ -78,7 +78,8 @@ use crate::rotation_fit::{closest_rotation_near, Mat3};
 #[derive(Clone, Debug, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ArapParams {
-    /// Iteration limit per solve.
+    /// Iteration limit per solve. 2000: the 1M bar and igea 2.1M need about 1,500 and 1,600
+    /// (docs/results.md, issue 63); every survey, real-mesh and dataset case far fewer.
     pub max_iterations: usize,
     /// Converged when the estimated distance to the fixed point (`crate::method::DistanceBound`,
     /// from the step sequence) falls below `tolerance x bbox diagonal`.
@@ -142,7 +143,7 @@ impl ArapParams {
 impl Default for ArapParams {
     fn default() -> Self {
         Self {
-            max_iterations: 1000,
+            max_iterations: 2000,
             tolerance: 1e-5,
             weights: LaplacianWeights::default(),
             acceleration: Acceleration::default(),
