@@ -135,7 +135,10 @@ pub enum Finding {
 impl Finding {
     /// Whether this finding fails the gate.
     pub fn is_regression(&self) -> bool {
-        !matches!(self, Finding::Better { .. } | Finding::Improved { .. } | Finding::IterateNotCompared { .. })
+        !matches!(
+            self,
+            Finding::Better { .. } | Finding::Improved { .. } | Finding::IterateNotCompared { .. }
+        )
     }
 }
 
@@ -496,14 +499,18 @@ mod tests {
         let findings = check(&base, &r);
         assert!(findings.len() == 1 && !findings[0].is_regression(), "{findings:?}");
         assert!(
-            findings[0].to_string().starts_with("not compared: bar / arap: unfinished in the baseline and in the run"),
+            findings[0]
+                .to_string()
+                .starts_with("not compared: bar / arap: unfinished in the baseline and in the run"),
             "{}",
             findings[0]
         );
         // The same change on a case finished in the run is compared (it is now ok: listed as such).
         let mut finished = r.clone();
         finished[0].status = Status::Ok;
-        assert!(check(&base, &finished).iter().any(|f| matches!(f, Finding::Worse { metric: Metric::EPhi, .. })));
+        assert!(check(&base, &finished)
+            .iter()
+            .any(|f| matches!(f, Finding::Worse { metric: Metric::EPhi, .. })));
         // A non-finite measure still fails.
         r[0].quality.set(Metric::EPhi, Some(f64::NAN));
         assert!(check(&base, &r).iter().any(|f| matches!(f, Finding::NonFinite { .. }) && f.is_regression()));
