@@ -245,8 +245,7 @@ pub fn check(baseline: &Baseline, results: &[CaseResult]) -> Vec<Finding> {
             continue;
         }
         let reference = index.get(&r.key()).copied();
-        let unfinished = STATUS_KINDS[2];
-        let iterates = reference.is_some_and(|b| b.verdict == unfinished) && r.status.kind() == unfinished;
+        let iterates = r.status.is_unfinished() && reference.is_some_and(|b| b.verdict == r.status.kind());
         if iterates {
             findings.push(Finding::IterateNotCompared { scenario: scenario.clone(), method: method.clone() });
         }

@@ -239,30 +239,22 @@ fn largest_turn(held: &[[f64; 3]], normals: &[[f64; 3]]) -> f64 {
 }
 
 /// `residual = rhs - A x` for a symmetric `A` stored with both triangles (`n x n`), `x` and
-/// `residual` of length `n`, `rhs` `n x 1`. Column `j` of `A` is its row `j`, so each entry is one
-/// column's dot product: no scatter, and the sum order is fixed.
+/// `residual` of length `n`, `rhs` `n x 1` ([`symmetric_product`], then the difference).
 fn symmetric_residual(
     a: SparseColMatRef<'_, usize, f64>,
     x: &[f64],
     rhs: MatRef<'_, f64>,
     residual: &mut [f64],
 ) {
-    let (col_ptr, row_idx, values) = (a.col_ptr(), a.row_idx(), a.val());
-    let row = |j: usize| -> f64 {
-        let mut s = 0.0;
-        for k in col_ptr[j]..col_ptr[j + 1] {
-            s += values[k] * x[row_idx[k]];
-        }
-        rhs[(j, 0)] - s
-    };
-    if residual.len() >= PARALLEL_MIN_ROWS {
-        residual.par_iter_mut().enumerate().for_each(|(j, r)| *r = row(j));
-    } else {
-        residual.iter_mut().enumerate().for_each(|(j, r)| *r = row(j));
+    symmetric_product(a, x, residual);
+    for (j, r) in residual.iter_mut().enumerate() {
+        *r = rhs[(j, 0)] - *r;
     }
 }
 
-/// `image = A x` for a symmetric `A` stored with both triangles (as [`symmetric_residual`]).
+/// `image = A x` for a symmetric `A` stored with both triangles (`n x n`; `x`, `image` of length
+/// `n`). Column `j` of `A` is its row `j`, so each entry is one column's dot product: no scatter,
+/// and the sum order is fixed.
 fn symmetric_product(a: SparseColMatRef<'_, usize, f64>, x: &[f64], image: &mut [f64]) {
     let (col_ptr, row_idx, values) = (a.col_ptr(), a.row_idx(), a.val());
     let row = |j: usize| -> f64 {
