@@ -143,12 +143,18 @@ impl VertexRecovery {
         symmetric_residual(self.matrix.as_ref(), &self.lagged, rhs, &mut self.residual);
         let mut rz = self.precondition();
         let first = rz;
+        if first == 0.0 {
+            // A zero residual: `current` solves the system.
+            for i in 0..n {
+                next[(i, 0)] = self.lagged[i];
+            }
+            return Some(1);
+        }
+        if !(first > 0.0) {
+            return None;
+        }
         self.direction.copy_from_slice(self.preconditioned.col_as_slice(0));
         for back_substitutions in 1..=limit {
-            if !(rz > 0.0) {
-                // A zero residual: `current` solves the system.
-                break;
-            }
             symmetric_product(self.matrix.as_ref(), &self.direction, &mut self.image);
             let curvature = dot(&self.direction, &self.image);
             if !(curvature > 0.0) || !curvature.is_finite() {
@@ -172,12 +178,6 @@ impl VertexRecovery {
             for i in 0..n {
                 self.direction[i] = z[i] + beta * self.direction[i];
             }
-        }
-        if first == 0.0 {
-            for i in 0..n {
-                next[(i, 0)] = self.lagged[i];
-            }
-            return Some(1);
         }
         None
     }
@@ -287,8 +287,8 @@ fn refactorization_cost(cholesky: &SparseCholesky) -> f64 {
 /// Blocked (supernodal) factorization against a single-column triangular solve, operations per
 /// second. Measured on this project's 2-core machine (docs/results.md, issue 63): the survey bar
 /// 6.4 back-substitutions per factorization at `sum c^2 / nnz = 179`, the plane 5.8 at 262,
-/// igea-134k 15 at 927: 14, 23 and 31; the middle is taken (an error of 1.5x moves the schedule's
-/// optimum little: the mean cost per step is flat near it).
+/// igea-134k 15 at 927: 14, 23 and 31; 20 is taken, between them (an error of 1.5x moves the
+/// schedule's optimum little: the mean cost per step is flat near it).
 const FACTORIZATION_SPEEDUP: f64 = 20.0;
 
 /// When the held factorization is retired (module documentation): costs counted in
